@@ -1,0 +1,41 @@
+// Dense tiles: a brick's values plus a halo from its neighbours, for stencil kernels.
+//
+// gather_tile fills a dense (8+2*halo)^3 float array for one brick: active voxels carry
+// their values, inactive ones +-background() by their sign (also in unallocated bricks).
+// Kernels then run plain loops (which the compiler vectorizes) without any lookups, and
+// scatter_active writes results back to the brick's active voxels only.
+// Layout: x fastest; tile index of local voxel (x,y,z), x,y,z in [-halo, 8+halo), is
+// (x+halo) + dim*((y+halo) + dim*(z+halo)) with dim = 8+2*halo.
+// Cost: O(dim^3) plus up to 26 neighbour resolutions (face links, rarely a hash lookup).
+// Threading: reads only; one tile buffer per thread.
+#pragma once
+
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "grid/narrow_band.hpp"
+
+namespace levelset {
+
+struct TileShape {
+  int halo = 1;
+  int dim() const { return kBrickDim + 2 * halo; }
+  std::size_t size() const { return std::size_t(dim()) * dim() * dim(); }
+  std::size_t index(int x, int y, int z) const {
+    const int d = dim();
+    return std::size_t(x + halo) + std::size_t(d) * (std::size_t(y + halo) + std::size_t(d) * std::size_t(z + halo));
+  }
+};
+
+// halo in [0, 8]. out.size() must be TileShape{halo}.size().
+void gather_tile(const NarrowBand& band, std::uint32_t brick, int halo, std::span<float> out);
+
+// Dense 512 values of one brick (halo 0) into out[local_index].
+void decode_brick(const NarrowBand& band, std::uint32_t brick, std::span<float, kBrickVoxels> out);
+
+// Writes tile values back to the active voxels of the brick (inactive voxels untouched,
+// signs of active voxels updated). tile is laid out with the given halo.
+void scatter_active(NarrowBand& band, std::uint32_t brick, int halo, std::span<const float> tile);
+
+}  // namespace levelset

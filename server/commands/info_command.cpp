@@ -1,0 +1,167 @@
+// levelsetd info FILE [--json]: what a mesh, point cloud or .lsg file holds.
+#include <algorithm>
+#include <cctype>
+#include <cstdio>
+#include <filesystem>
+#include <iostream>
+
+#include <nlohmann/json.hpp>
+
+#include "commands/commands.hpp"
+#include "commands/report.hpp"
+#include "core/error.hpp"
+#include "grid/lsg_file.hpp"
+#include "io/mesh_reader.hpp"
+#include "io/point_cloud_reader.hpp"
+
+namespace levelset::cli {
+
+namespace {
+
+using nlohmann::json;
+
+json vec_json(const Vec3d& v) { return json::array({v.x, v.y, v.z}); }
+json bbox_json(const BBox& b) {
+  if (b.empty()) return nullptr;
+  return json{{"min", vec_json(b.min)}, {"max", vec_json(b.max)}};
+}
+
+std::string lower_extension(const std::string& path) {
+  std::string ext = std::filesystem::path(path).extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
+  return ext;
+}
+
+std::string point_cloud_format_name(PointCloudFormat f) {
+  switch (f) {
+    case PointCloudFormat::Xyz: return "xyz";
+    case PointCloudFormat::Xyzn: return "xyzn";
+    case PointCloudFormat::Pwn: return "pwn";
+    case PointCloudFormat::Ply: return "ply";
+  }
+  return "unknown";
+}
+
+json lsg_info(const std::string& path) {
+  const LsgReadResult r = load_lsg(path);
+  const NarrowBand& band = r.band;
+  const IndexBox ib = band.active_index_bounds();
+  json j;
+  j["kind"] = "narrow_band";
+  j["format"] = "lsg";
+  j["version"] = r.header.version;
+  j["value_type"] = "float32";
+  j["voxel_size"] = band.voxel_size();
+  j["origin"] = vec_json(band.origin());
+  j["band_half_width_voxels"] = band.half_width();
+  j["band_half_width"] = band.background();
+  j["far_inside"] = band.far_inside();
+  j["bricks"] = band.brick_count();
+  j["active_voxels"] = band.active_voxel_count();
+  j["memory_bytes"] = band.memory_bytes();
+  j["bytes_per_active_voxel"] =
+      band.active_voxel_count() ? double(band.memory_bytes()) / double(band.active_voxel_count()) : 0.0;
+  j["file_bytes"] = r.file_bytes;
+  j["index_bounds"] = ib.empty() ? json(nullptr)
+                                 : json{{"min", {ib.min.x, ib.min.y, ib.min.z}},
+                                        {"max", {ib.max.x, ib.max.y, ib.max.z}}};
+  j["world_bounds"] = bbox_json(band.active_world_bounds());
+  return j;
+}
+
+json mesh_info(const std::string& path) {
+  const MeshReadResult r = read_mesh(path);
+  json j;
+  j["kind"] = "mesh";
+  j["format"] = std::string(to_string(r.format));
+  j["vertices"] = r.mesh.vertices.size();
+  j["triangles"] = r.mesh.triangles.size();
+  j["source_faces"] = r.source_faces;
+  j["polygons_triangulated"] = r.polygons_triangulated;
+  j["world_bounds"] = bbox_json(r.mesh.bounds());
+  return j;
+}
+
+json cloud_info(const std::string& path) {
+  const PointCloudReadResult r = read_point_cloud(path);
+  json j;
+  j["kind"] = "point_cloud";
+  j["format"] = point_cloud_format_name(r.format);
+  j["points"] = r.cloud.points.size();
+  j["normals"] = r.cloud.has_normals();
+  j["world_bounds"] = bbox_json(r.cloud.bounds());
+  return j;
+}
+
+void print_human(const std::string& path, const json& j) {
+  auto vec = [](const json& v) {
+    char buf[128];
+    std::snprintf(buf, sizeof buf, "(%.6g, %.6g, %.6g)", v[0].get<double>(), v[1].get<double>(),
+                  v[2].get<double>());
+    return std::string(buf);
+  };
+  std::printf("file:            %s\n", path.c_str());
+  const std::string kind = j["kind"];
+  if (kind == "narrow_band") {
+    std::printf("kind:            narrow band (.lsg v%u, float32)\n", j["version"].get<unsigned>());
+    std::printf("voxel size:      %.9g\n", j["voxel_size"].get<double>());
+    std::printf("origin:          %s\n", vec(j["origin"]).c_str());
+    std::printf("band:            %.6g voxels half-width (%.6g world)\n",
+                j["band_half_width_voxels"].get<double>(), j["band_half_width"].get<double>());
+    std::printf("bricks:          %llu\n", j["bricks"].get<unsigned long long>());
+    std::printf("active voxels:   %llu\n", j["active_voxels"].get<unsigned long long>());
+    std::printf("memory:          %s (%.2f B per active voxel)\n",
+                human_bytes(j["memory_bytes"]).c_str(), j["bytes_per_active_voxel"].get<double>());
+    std::printf("file size:       %s\n", human_bytes(j["file_bytes"]).c_str());
+  } else if (kind == "mesh") {
+    std::printf("kind:            triangle mesh (%s)\n", j["format"].get<std::string>().c_str());
+    std::printf("vertices:        %llu\n", j["vertices"].get<unsigned long long>());
+    std::printf("triangles:       %llu (from %llu faces)\n", j["triangles"].get<unsigned long long>(),
+                j["source_faces"].get<unsigned long long>());
+  } else {
+    std::printf("kind:            point cloud (%s)\n", j["format"].get<std::string>().c_str());
+    std::printf("points:          %llu%s\n", j["points"].get<unsigned long long>(),
+                j["normals"].get<bool>() ? " with normals" : "");
+  }
+  if (!j["world_bounds"].is_null())
+    std::printf("bounds:          %s - %s\n", vec(j["world_bounds"]["min"]).c_str(),
+                vec(j["world_bounds"]["max"]).c_str());
+}
+
+}  // namespace
+
+int run_info(const InfoArgs& args) {
+  const std::string ext = lower_extension(args.path);
+  json j;
+  if (ext == ".lsg") {
+    j = lsg_info(args.path);
+  } else if (ext == ".xyz" || ext == ".xyzn" || ext == ".pwn") {
+    j = cloud_info(args.path);
+  } else if (ext == ".ply") {
+    // A PLY with a face element is a mesh; one with vertices only is a point cloud.
+    try {
+      j = mesh_info(args.path);
+    } catch (const Error& mesh_error) {
+      if (mesh_error.code() != ErrorCode::ParseError) throw;
+      try {
+        j = cloud_info(args.path);
+      } catch (const Error&) {
+        throw mesh_error;
+      }
+    }
+  } else if (ext == ".off" || ext == ".tria" || ext == ".obj" || ext == ".stl") {
+    j = mesh_info(args.path);
+  } else {
+    throw Error(ErrorCode::UnsupportedFormat, args.path,
+                "unknown extension '" + ext + "' (known: .lsg .off .tria .ply .obj .stl .xyz .xyzn .pwn)");
+  }
+  j["file"] = args.path;
+  if (args.json) {
+    std::cout << j.dump(2) << "\n";
+  } else {
+    print_human(args.path, j);
+  }
+  return 0;
+}
+
+}  // namespace levelset::cli

@@ -1,0 +1,44 @@
+#include "commands/report.hpp"
+
+#include <cstdio>
+#include <iostream>
+
+#include "core/file_io.hpp"
+
+namespace levelset::cli {
+
+nlohmann::json Stats::to_json() const {
+  nlohmann::json j = extra;
+  j["op"] = op;
+  j["seconds"] = seconds;
+  j["threads"] = threads;
+  j["active_voxels"] = active_voxels;
+  j["bytes"] = bytes;
+  return j;
+}
+
+void write_stats(const Stats& stats, const std::string& path) {
+  if (path.empty()) return;
+  const std::string text = stats.to_json().dump(2) + "\n";
+  if (path == "-") {
+    std::cout << text;
+  } else {
+    write_file_atomically(path, text);
+  }
+}
+
+std::string human_bytes(std::uint64_t bytes) {
+  char buf[64];
+  if (bytes < 1024) {
+    std::snprintf(buf, sizeof buf, "%llu B", static_cast<unsigned long long>(bytes));
+  } else if (bytes < (1u << 20)) {
+    std::snprintf(buf, sizeof buf, "%.1f KiB", bytes / 1024.0);
+  } else if (bytes < (1u << 30)) {
+    std::snprintf(buf, sizeof buf, "%.2f MiB", bytes / 1048576.0);
+  } else {
+    std::snprintf(buf, sizeof buf, "%.2f GiB", bytes / 1073741824.0);
+  }
+  return buf;
+}
+
+}  // namespace levelset::cli

@@ -1,0 +1,32 @@
+// Shared output helpers for batch subcommands: the --stats JSON schema and human formatting.
+//
+// Every subcommand's --stats writes one JSON object:
+//   {"op": NAME, "seconds": {"total": T, PHASE: T...}, "threads": N, "active_voxels": N,
+//    "bytes": N, ...op-specific fields}
+// to a file, or to stdout for "-".
+#pragma once
+
+#include <cstdint>
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+namespace levelset::cli {
+
+struct Stats {
+  std::string op;
+  nlohmann::json seconds = nlohmann::json::object();
+  nlohmann::json extra = nlohmann::json::object();
+  int threads = 0;
+  std::uint64_t active_voxels = 0;
+  std::uint64_t bytes = 0;
+
+  nlohmann::json to_json() const;
+};
+
+// Writes stats to path ("-" = stdout); no-op for an empty path.
+void write_stats(const Stats& stats, const std::string& path);
+
+std::string human_bytes(std::uint64_t bytes);
+
+}  // namespace levelset::cli
