@@ -26,7 +26,7 @@ class BandAccessor {
     if (b == kNoBrick) return band_->is_inside_unallocated(c) ? -bg() : bg();
     const Brick& br = band_->bricks()[b];
     if (br.active.test(n)) return band_->values()[br.value_offset + br.slot(n)];
-    return br.inside.test(n) ? -bg() : bg();
+    return band_->stored_inside(br, n) ? -bg() : bg();
   }
   std::optional<float> probe(const Coord& c) {
     const std::uint32_t b = locate(brick_of(c));
@@ -43,7 +43,7 @@ class BandAccessor {
   bool is_inside(const Coord& c) {
     const std::uint32_t b = locate(brick_of(c));
     if (b == kNoBrick) return band_->is_inside_unallocated(c);
-    return band_->bricks()[b].inside.test(local_index(c));
+    return band_->voxel_inside(b, local_index(c));
   }
 
   // Brick index for brick coordinates, using the cache and neighbour tables.

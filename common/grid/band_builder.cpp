@@ -12,8 +12,9 @@ namespace levelset {
 namespace {
 struct StagedBrick {
   std::uint64_t key;
-  Brick brick;          // value_offset: offset in the owning thread's staged values
-  std::uint32_t owner;  // index of the thread-local staging it lives in
+  BrickRecord record;
+  std::uint32_t staged_offset;  // first value in the owning thread's staged values
+  std::uint32_t owner;          // index of the thread-local staging it lives in
 };
 struct LocalStaging {
   std::vector<StagedBrick> bricks;
@@ -40,11 +41,10 @@ void BandBuilder::add_brick(const Coord& brick, const BrickMask& active, const B
                 "brick (" + std::to_string(brick.x) + "," + std::to_string(brick.y) + "," +
                     std::to_string(brick.z) + ") is outside the index range");
   LocalStaging& s = staging_->local.local();
-  StagedBrick sb{brick_key(brick), {}, 0};
-  sb.brick.coord = brick;
-  sb.brick.active = active;
-  sb.brick.inside = inside;
-  sb.brick.value_offset = static_cast<std::uint32_t>(s.values.size());
+  StagedBrick sb{brick_key(brick), {brick, active, inside}, 0, 0};
+  if (s.values.size() >= 0xffffffffu)
+    throw Error(ErrorCode::LimitExceeded, "BandBuilder", "more than 2^32-1 staged voxels");
+  sb.staged_offset = static_cast<std::uint32_t>(s.values.size());
   active.for_each_set([&](int n) { s.values.push_back(dense_values[n]); });
   s.bricks.push_back(sb);
 }
@@ -64,18 +64,19 @@ NarrowBand BandBuilder::finish(bool far_inside) {
             [](const StagedBrick& a, const StagedBrick& b) { return a.key < b.key; });
   for (std::size_t i = 1; i < all.size(); ++i) {
     if (all[i].key == all[i - 1].key) {
-      const Coord c = all[i].brick.coord;
+      const Coord c = all[i].record.coord;
       throw Error(ErrorCode::InvalidArgument, "BandBuilder",
                   "brick (" + std::to_string(c.x) + "," + std::to_string(c.y) + "," +
                       std::to_string(c.z) + ") added twice");
     }
   }
-  std::vector<Brick> bricks(all.size());
+  std::vector<BrickRecord> records(all.size());
+  std::vector<std::uint64_t> offsets(all.size());
   std::uint64_t total = 0;
   for (std::size_t i = 0; i < all.size(); ++i) {
-    bricks[i] = all[i].brick;
-    bricks[i].value_offset = static_cast<std::uint32_t>(total);
-    total += static_cast<std::uint64_t>(all[i].brick.active.count());
+    records[i] = all[i].record;
+    offsets[i] = total;
+    total += static_cast<std::uint64_t>(all[i].record.active.count());
     if (total >= 0xffffffffull)
       throw Error(ErrorCode::LimitExceeded, "BandBuilder", "more than 2^32-1 active voxels");
   }
@@ -84,13 +85,12 @@ NarrowBand BandBuilder::finish(bool far_inside) {
                     [&](const tbb::blocked_range<std::size_t>& r) {
                       for (std::size_t i = r.begin(); i != r.end(); ++i) {
                         const StagedBrick& sb = all[i];
-                        const float* src = owners[sb.owner]->values.data() + sb.brick.value_offset;
-                        std::copy_n(src, sb.brick.active.count(),
-                                    values.data() + bricks[i].value_offset);
+                        const float* src = owners[sb.owner]->values.data() + sb.staged_offset;
+                        std::copy_n(src, sb.record.active.count(), values.data() + offsets[i]);
                       }
                     });
   staging_ = std::make_unique<Staging>();
-  return NarrowBand::assemble(frame_, std::move(bricks), std::move(values), far_inside);
+  return NarrowBand::assemble(frame_, std::move(records), std::move(values), far_inside);
 }
 
 }  // namespace levelset

@@ -56,7 +56,11 @@ std::string raw_payload(const NarrowBand& band) {
     p += 12;
   }
   for (const Brick& b : bricks) { std::memcpy(p, b.active.words.data(), 64); p += 64; }
-  for (const Brick& b : bricks) { std::memcpy(p, b.inside.words.data(), 64); p += 64; }
+  for (std::uint32_t b = 0; b < nb; ++b) {
+    const BrickMask inside = band.inside_mask(b);
+    std::memcpy(p, inside.words.data(), 64);
+    p += 64;
+  }
   // Byte planes: all byte 0s, then all byte 1s, ...
   for (std::size_t i = 0; i < nv; ++i) {
     std::uint32_t u;
@@ -212,11 +216,12 @@ LsgReadResult decode_lsg(std::string_view bytes, std::string_view name, const Ls
   options.progress.step(0.6, "bricks");
 
   const std::size_t nb = static_cast<std::size_t>(h.bricks), nv = static_cast<std::size_t>(h.active_voxels);
-  std::vector<Brick> bricks(nb);
+  std::vector<BrickRecord> bricks(nb);
   const char* p = raw.data();
+  std::vector<std::uint64_t> offsets(nb);
   std::uint64_t total = 0;
   for (std::size_t i = 0; i < nb; ++i) {
-    Brick& b = bricks[i];
+    BrickRecord& b = bricks[i];
     std::memcpy(&b.coord.x, p + 12 * i, 4);
     std::memcpy(&b.coord.y, p + 12 * i + 4, 4);
     std::memcpy(&b.coord.z, p + 12 * i + 8, 4);
@@ -225,7 +230,7 @@ LsgReadResult decode_lsg(std::string_view bytes, std::string_view name, const Ls
     if (!brick_in_range(b.coord)) corrupt(name, 0, "brick " + std::to_string(i) + " out of range");
     if (i > 0 && brick_key(bricks[i - 1].coord) >= brick_key(b.coord))
       corrupt(name, 0, "bricks not sorted or duplicated at brick " + std::to_string(i));
-    b.value_offset = static_cast<std::uint32_t>(total);
+    offsets[i] = total;
     total += static_cast<std::uint64_t>(b.active.count());
   }
   if (total != h.active_voxels)
@@ -241,8 +246,8 @@ LsgReadResult decode_lsg(std::string_view bytes, std::string_view name, const Ls
     if (!std::isfinite(values[i])) corrupt(name, 0, "non-finite value at voxel " + std::to_string(i));
   }
   for (std::size_t i = 0; i < nb; ++i) {
-    const Brick& b = bricks[i];
-    const float* v = values.data() + b.value_offset;
+    const BrickRecord& b = bricks[i];
+    const float* v = values.data() + offsets[i];
     bool ok = true;
     b.active.for_each_set([&](int n) { ok &= (*v++ < 0.0f) == b.inside.test(n); });
     if (!ok) corrupt(name, 0, "sign bits disagree with values in brick " + std::to_string(i));

@@ -10,10 +10,11 @@
 //   (or far_inside() when the row is empty). This is exact under the band invariant:
 //   two 6-adjacent voxels of opposite sign are both active (|u| <= h <= W*h), so a run of
 //   inactive voxels never crosses the zero level.
-// - Storage: bricks of 8^3 voxels in (z,y,x) key order; per brick an active mask, an inside
-//   mask, per-word rank bases and 6 face-neighbour indices (stencils that leave a brick
-//   never hash). Values of active voxels only, packed brick after brick in one vector:
-//   about 4.2-5 bytes per active voxel on thin bands.
+// - Storage: bricks of 8^3 voxels in (z,y,x) key order (grid/brick.hpp): per brick an active
+//   mask, packed per-word rank bases, 6 face-neighbour indices (stencils that leave a brick
+//   never hash) and a compact sign rule for inactive voxels (a 512-bit mask only for bricks
+//   whose inactive voxels lie on both sides). Values of active voxels only, packed brick
+//   after brick in one vector: about 4.8 bytes per active voxel on thin bands.
 // - Cost: value lookup O(1) (hash + popcount); set_value on an active voxel O(1), on an
 //   inactive one O(active voxels) (packed arrays shift; bulk changes go through
 //   BandBuilder); sign query in an unallocated brick O(log bricks).
@@ -32,26 +33,12 @@
 
 #include "core/bbox.hpp"
 #include "core/vec3.hpp"
+#include "grid/brick.hpp"
 #include "grid/brick_mask.hpp"
 #include "grid/brick_table.hpp"
 #include "grid/coord.hpp"
 
 namespace levelset {
-
-struct Brick {
-  Coord coord;                        // brick coordinates (voxel index >> 3)
-  std::uint32_t value_offset = 0;     // first value of this brick in NarrowBand::values()
-  BrickMask active;                   // voxel holds a value
-  BrickMask inside;                   // voxel is inside (value < 0); kept for inactive voxels too
-  std::array<std::uint16_t, 8> rank_base{};  // active voxels in words before word w
-  std::array<std::uint32_t, 6> neighbor{};   // -x,+x,-y,+y,-z,+z brick index or kNoBrick
-
-  int active_count() const { return rank_base[7] + std::popcount(active.words[7]); }
-  // Slot of active voxel n within this brick's values.
-  int slot(int n) const { return rank_base[n >> 6] + active.rank_in_word(n); }
-};
-
-enum class Face : int { MinusX = 0, PlusX, MinusY, PlusY, MinusZ, PlusZ };
 
 struct GridFrame {
   double voxel_size = 1.0;
@@ -93,9 +80,25 @@ class NarrowBand {
   }
   // Brick index for brick coordinates, kNoBrick if not allocated (one hash lookup).
   std::uint32_t find_brick(const Coord& brick) const {
-    return brick_in_range(brick) ? table_.find(brick_key(brick)) : kNoBrick;
+    return brick_in_range(brick) ? table_.find(brick, bricks_) : kNoBrick;
   }
   std::uint32_t neighbor(std::uint32_t b, Face f) const { return bricks_[b].neighbor[int(f)]; }
+
+  // Stored sign of voxel n of a brick, for inactive voxels (active ones: value < 0).
+  bool stored_inside(const Brick& br, int n) const {
+    if (br.signs == kSignsAllOutside) return false;
+    if (br.signs == kSignsAllInside) return true;
+    return sign_masks_[br.signs].test(n);
+  }
+  // Sign of voxel n of brick b, active or not.
+  bool voxel_inside(std::uint32_t b, int n) const {
+    const Brick& br = bricks_[b];
+    return br.active.test(n) ? values_[br.value_offset + br.slot(n)] < 0.0f : stored_inside(br, n);
+  }
+  // The full inside mask of brick b (all 512 voxels).
+  BrickMask inside_mask(std::uint32_t b) const;
+  // Number of bricks that own a sign mask (inactive voxels on both sides).
+  std::size_t mixed_sign_bricks() const { return sign_masks_.size(); }
 
   // Point access by voxel index (convenience; hot loops use BandAccessor or tiles).
   bool is_active(const Coord& c) const;
@@ -130,32 +133,36 @@ class NarrowBand {
     br.active.for_each_set([&](int n) { f(o + local_coord(n), *v++); });
   }
 
-  // f(int n, float old) -> float for every active voxel n of brick b; stores the result and
-  // its sign. Topology is unchanged. Safe in parallel for distinct bricks.
+  // f(int n, float old) -> float for every active voxel n of brick b; stores the result
+  // (whose sign is the voxel's sign). Topology is unchanged. Safe in parallel for distinct
+  // bricks.
   template <typename F>
   void update_active_in_brick(std::uint32_t b, F&& f) {
-    Brick& br = bricks_[b];
+    const Brick& br = bricks_[b];
     float* v = values_.data() + br.value_offset;
     br.active.for_each_set([&](int n) {
       *v = f(n, *v);
-      br.inside.assign(n, *v < 0.0f);
       ++v;
     });
   }
 
-  // Raw construction for BandBuilder and the file reader: bricks sorted by key with
-  // masks set and value_offset consistent; derives rank bases, hash and neighbours.
-  static NarrowBand assemble(const GridFrame& frame, std::vector<Brick> bricks,
+  // Raw construction for BandBuilder and the file reader: records sorted by brick key
+  // without duplicates, values packed record after record in active-mask order. Throws
+  // Error{InvalidArgument} when the records break these rules.
+  static NarrowBand assemble(const GridFrame& frame, std::vector<BrickRecord> records,
                              std::vector<float> values, bool far_inside);
 
  private:
   void rebuild_index();  // rank bases, hash table, neighbour tables
+  // Sign rule for a brick from its full inside mask (allocating a side mask if mixed).
+  std::uint32_t compress_signs(const BrickMask& active, const BrickMask& inside);
 
   GridFrame frame_{};
   float background_ = 3.0f;
   bool far_inside_ = false;
   std::vector<Brick> bricks_;
   std::vector<float> values_;
+  std::vector<BrickMask> sign_masks_;
   BrickTable table_;
 };
 

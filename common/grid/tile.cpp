@@ -26,9 +26,10 @@ std::uint32_t neighbor_at(const NarrowBand& band, std::uint32_t b, const Coord& 
 void decode_brick(const NarrowBand& band, std::uint32_t brick, std::span<float, kBrickVoxels> out) {
   const Brick& br = band.bricks()[brick];
   const float bg = band.background();
-  for (int w = 0; w < 8; ++w) {
-    const std::uint64_t in = br.inside.words[w];
-    for (int bit = 0; bit < 64; ++bit) out[w * 64 + bit] = ((in >> bit) & 1u) ? -bg : bg;
+  if (br.signs == kSignsAllOutside || br.signs == kSignsAllInside) {
+    std::fill(out.begin(), out.end(), br.signs == kSignsAllInside ? -bg : bg);
+  } else {
+    for (int n = 0; n < kBrickVoxels; ++n) out[n] = band.stored_inside(br, n) ? -bg : bg;
   }
   const float* v = band.values().data() + br.value_offset;
   br.active.for_each_set([&](int n) { out[n] = *v++; });
@@ -82,7 +83,7 @@ void gather_tile(const NarrowBand& band, std::uint32_t brick, int halo, std::spa
             for (int x = lo[0]; x < hi[0]; ++x) {
               const int n = local_index(x, y, z);
               out[shape.index(x + d.x * kBrickDim, y + d.y * kBrickDim, z + d.z * kBrickDim)] =
-                  br.active.test(n) ? vals[br.slot(n)] : (br.inside.test(n) ? -bg : bg);
+                  br.active.test(n) ? vals[br.slot(n)] : (band.stored_inside(br, n) ? -bg : bg);
             }
       }
     }

@@ -32,16 +32,6 @@ std::string lower_extension(const std::string& path) {
   return ext;
 }
 
-std::string point_cloud_format_name(PointCloudFormat f) {
-  switch (f) {
-    case PointCloudFormat::Xyz: return "xyz";
-    case PointCloudFormat::Xyzn: return "xyzn";
-    case PointCloudFormat::Pwn: return "pwn";
-    case PointCloudFormat::Ply: return "ply";
-  }
-  return "unknown";
-}
-
 json lsg_info(const std::string& path) {
   const LsgReadResult r = load_lsg(path);
   const NarrowBand& band = r.band;
@@ -86,7 +76,7 @@ json cloud_info(const std::string& path) {
   const PointCloudReadResult r = read_point_cloud(path);
   json j;
   j["kind"] = "point_cloud";
-  j["format"] = point_cloud_format_name(r.format);
+  j["format"] = std::string(to_string(r.format));
   j["points"] = r.cloud.points.size();
   j["normals"] = r.cloud.has_normals();
   j["world_bounds"] = bbox_json(r.cloud.bounds());

@@ -52,19 +52,23 @@ TEST(NarrowBand, RejectsBadFrames) {
 TEST(NarrowBand, PointEditsMatchAReferenceMap) {
   NarrowBand band(GridFrame{0.5, {1, 2, 3}, 2.0});
   std::map<Coord, float, CoordLess> ref;
+  std::map<Coord, bool, CoordLess> retired_sign;  // deactivated voxels keep their last sign
   std::mt19937 rng(11);
   std::uniform_int_distribution<int> coord(-13, 12);
   std::uniform_real_distribution<float> val(-1.0f, 1.0f);
   for (int round = 0; round < 6; ++round) {
     for (int i = 0; i < 300; ++i) {
-      const Coord c{coord(rng), coord(rng), coord(rng)};
+      Coord c{coord(rng), coord(rng), coord(rng)};
       if (rng() % 4 == 0) {
+        if (!ref.empty() && rng() % 2 == 0) c = std::next(ref.begin(), long(rng() % ref.size()))->first;
         band.deactivate(c);
+        if (ref.count(c)) retired_sign[c] = ref[c] < 0.0f;
         ref.erase(c);
       } else {
         const float v = val(rng);
         band.set_value(c, v);
         ref[c] = v;
+        retired_sign.erase(c);
       }
     }
     ASSERT_EQ(band.active_voxel_count(), ref.size());
@@ -79,6 +83,11 @@ TEST(NarrowBand, PointEditsMatchAReferenceMap) {
             ASSERT_EQ(band.is_inside(c), it->second < 0.0f);
           } else {
             ASSERT_FALSE(band.value(c).has_value());
+            auto rs = retired_sign.find(c);
+            if (rs != retired_sign.end()) {
+              ASSERT_EQ(band.is_inside(c), rs->second);
+              ASSERT_EQ(band.value_or_background(c), rs->second ? -band.background() : band.background());
+            }
           }
         }
     // Iteration visits every active voxel once, in storage order, with its value.
@@ -93,6 +102,8 @@ TEST(NarrowBand, PointEditsMatchAReferenceMap) {
     for (std::size_t i = 1; i < bricks.size(); ++i)
       EXPECT_LT(brick_key(bricks[i - 1].coord), brick_key(bricks[i].coord));
   }
+  EXPECT_GT(band.mixed_sign_bricks(), 0u);  // retired voxels of both signs made mixed bricks
+  EXPECT_GT(retired_sign.size(), 50u);
 }
 
 TEST(NarrowBand, RejectsNonFiniteValuesAndOutOfRangeCoordinates) {
