@@ -125,6 +125,11 @@ class NarrowBand {
   void for_each_active(F&& f) const {
     for (std::uint32_t b = 0; b < bricks_.size(); ++b) for_each_active_in_brick(b, f);
   }
+  // f(Coord voxel, Vec3d world_position, float value) for every active voxel, serial.
+  template <typename F>
+  void for_each_active_world(F&& f) const {
+    for_each_active([&](const Coord& c, float v) { f(c, world(c), v); });
+  }
   template <typename F>
   void for_each_active_in_brick(std::uint32_t b, F&& f) const {
     const Brick& br = bricks_[b];

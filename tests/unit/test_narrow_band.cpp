@@ -153,6 +153,15 @@ TEST_P(ShapeBandTest, ValuesMembershipSignsAndInvariant) {
       }
   EXPECT_EQ(active, band.active_voxel_count());
   EXPECT_EQ(band.active_index_bounds(), dense_bounds);
+  // Iteration with world positions: each value is the SDF at the reported position.
+  std::uint64_t visited = 0;
+  band.for_each_active_world([&](const Coord& c, const Vec3d& p, float v) {
+    ++visited;
+    const Vec3d expected = band.origin() + Vec3d{double(c.x), double(c.y), double(c.z)} * band.voxel_size();
+    ASSERT_EQ(p, expected);
+    ASSERT_EQ(v, static_cast<float>(sb.shape->distance(p)));
+  });
+  EXPECT_EQ(visited, band.active_voxel_count());
   EXPECT_FALSE(band.is_inside({100000, -5000, 7}));
   const BBox wb = band.active_world_bounds();
   const BBox sbnd = sb.shape->bounds();
