@@ -45,7 +45,13 @@ int main(int argc, char** argv) {
   prim_cmd->add_option("--stats", prim.stats, "Write timing statistics as JSON to FILE (or - for stdout)");
   add_threads_option(prim_cmd, prim.threads);
 
-  CLI11_PARSE(app, argc, argv);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    if (e.get_exit_code() == 0) return app.exit(e);  // --help, --version
+    std::fprintf(stderr, "levelsetd: usage: %s (see levelsetd --help)\n", e.what());
+    return 2;
+  }
 
   std::optional<tbb::global_control> limit;
   const int threads = prim.threads;

@@ -74,6 +74,11 @@ std::string raw_payload(const NarrowBand& band) {
   throw Error(ErrorCode::Corrupt, at_byte(name, at), why);
 }
 
+// Structure errors inside the decompressed payload name the payload offset.
+[[noreturn]] void corrupt_payload(std::string_view name, std::uint64_t at, const std::string& why) {
+  throw Error(ErrorCode::Corrupt, std::string(name) + " @ payload byte " + std::to_string(at), why);
+}
+
 // Streaming decompression: the output grows with what zstd actually produces and may never
 // exceed `expected`, so a tiny file claiming a huge payload cannot force a huge allocation.
 std::string decompress_bounded(std::string_view stored, std::uint64_t expected, std::string_view name,
@@ -149,8 +154,9 @@ LsgWriteResult save_lsg(const NarrowBand& band, const std::filesystem::path& pat
 }
 
 LsgReadResult decode_lsg(std::string_view bytes, std::string_view name, const LsgReadOptions& options) {
-  if (bytes.size() < 8 || std::memcmp(bytes.data(), kMagic, 8) != 0) {
-    if (bytes.size() < 8 && std::memcmp(bytes.data(), kMagic, bytes.size()) == 0)
+  const std::string_view magic(kMagic, 8);
+  if (bytes.substr(0, 8) != magic) {
+    if (bytes.size() < 8 && magic.substr(0, bytes.size()) == bytes)
       throw Error(ErrorCode::Truncated, at_byte(name, bytes.size()), "file ends inside the magic");
     throw Error(ErrorCode::UnsupportedFormat, at_byte(name, 0), "not an .lsg file (wrong magic)");
   }
@@ -194,6 +200,11 @@ LsgReadResult decode_lsg(std::string_view bytes, std::string_view name, const Ls
   if (checksum(bytes.substr(0, kChecksumOffset), bytes.substr(kHeaderBytes)) != stored_sum)
     corrupt(name, kChecksumOffset, "checksum mismatch: the file is damaged");
 
+  if (!(std::isfinite(h.frame.voxel_size) && h.frame.voxel_size > 0))
+    corrupt(name, 24, "voxel size must be finite and > 0");
+  if (!isfinite(h.frame.origin)) corrupt(name, 32, "origin must be finite");
+  if (!(h.frame.half_width >= 1.0 && h.frame.half_width <= 1024.0))
+    corrupt(name, 56, "band half-width must be in [1, 1024] voxels");
   try {
     NarrowBand validate(h.frame);
     (void)validate;
@@ -227,9 +238,10 @@ LsgReadResult decode_lsg(std::string_view bytes, std::string_view name, const Ls
     std::memcpy(&b.coord.z, p + 12 * i + 8, 4);
     std::memcpy(b.active.words.data(), p + 12 * nb + 64 * i, 64);
     std::memcpy(b.inside.words.data(), p + 76 * nb + 64 * i, 64);
-    if (!brick_in_range(b.coord)) corrupt(name, 0, "brick " + std::to_string(i) + " out of range");
+    if (!brick_in_range(b.coord))
+      corrupt_payload(name, 12 * i, "brick " + std::to_string(i) + " out of range");
     if (i > 0 && brick_key(bricks[i - 1].coord) >= brick_key(b.coord))
-      corrupt(name, 0, "bricks not sorted or duplicated at brick " + std::to_string(i));
+      corrupt_payload(name, 12 * i, "bricks not sorted or duplicated at brick " + std::to_string(i));
     offsets[i] = total;
     total += static_cast<std::uint64_t>(b.active.count());
   }
@@ -243,14 +255,16 @@ LsgReadResult decode_lsg(std::string_view bytes, std::string_view name, const Ls
                             (std::uint32_t(planes[2 * nv + i]) << 16) |
                             (std::uint32_t(planes[3 * nv + i]) << 24);
     std::memcpy(&values[i], &u, 4);
-    if (!std::isfinite(values[i])) corrupt(name, 0, "non-finite value at voxel " + std::to_string(i));
+    if (!std::isfinite(values[i]))
+      corrupt_payload(name, kBytesPerBrick * nb + i, "non-finite value at voxel " + std::to_string(i));
   }
   for (std::size_t i = 0; i < nb; ++i) {
     const BrickRecord& b = bricks[i];
     const float* v = values.data() + offsets[i];
     bool ok = true;
     b.active.for_each_set([&](int n) { ok &= (*v++ < 0.0f) == b.inside.test(n); });
-    if (!ok) corrupt(name, 0, "sign bits disagree with values in brick " + std::to_string(i));
+    if (!ok)
+      corrupt_payload(name, 76 * nb + 64 * i, "sign bits disagree with values in brick " + std::to_string(i));
   }
   options.progress.step(0.9, "index");
   LsgReadResult result{NarrowBand::assemble(h.frame, std::move(bricks), std::move(values), h.far_inside),

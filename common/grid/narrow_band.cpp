@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <string>
 
@@ -25,10 +26,11 @@ void validate_frame(const GridFrame& f) {
 }
 
 void check_coord(const Coord& c) {
-  if (!brick_in_range(brick_of(c)))
-    throw Error(ErrorCode::InvalidArgument, "voxel index",
-                "(" + std::to_string(c.x) + "," + std::to_string(c.y) + "," + std::to_string(c.z) +
-                    ") is outside the index range +-" + std::to_string(kVoxelCoordLimit));
+  if (brick_in_range(brick_of(c))) return;
+  char msg[128];
+  std::snprintf(msg, sizeof msg, "(%d,%d,%d) is outside the index range +-%d", c.x, c.y, c.z,
+                kVoxelCoordLimit);
+  throw Error(ErrorCode::InvalidArgument, "voxel index", msg);
 }
 
 bool brick_key_less(const Brick& a, const Brick& b) {
@@ -265,7 +267,8 @@ bool NarrowBand::identical(const NarrowBand& o) const {
         !(inside_mask(i) == o.inside_mask(i)))
       return false;
   }
-  return std::memcmp(values_.data(), o.values_.data(), values_.size() * sizeof(float)) == 0;
+  return values_.empty() ||
+         std::memcmp(values_.data(), o.values_.data(), values_.size() * sizeof(float)) == 0;
 }
 
 }  // namespace levelset

@@ -1,0 +1,172 @@
+#!/usr/bin/env bash
+# CLI round trips through the real levelsetd binary.
+# Usage: cli_roundtrip.sh LEVELSETD_BINARY SCRATCH_DIR
+# Builds every builtin shape with `primitive`, reads it back with `info` (text and JSON,
+# checked against the --stats JSON) and runs the error paths: each must exit non-zero (never
+# by a signal) with one line "levelsetd: ..." on stderr that names the problem.
+set -euo pipefail
+
+if [[ $# -ne 2 ]]; then
+  echo "usage: $0 LEVELSETD_BINARY SCRATCH_DIR" >&2
+  exit 2
+fi
+BIN=$1
+DIR=$2
+PY=/usr/bin/python3
+rm -rf "$DIR"
+mkdir -p "$DIR"
+
+checks=0
+failures=0
+fail() {
+  echo "cli_roundtrip: FAILED: $*" >&2
+  exit 1
+}
+# A failed error-path check is reported, and the remaining checks still run.
+soft_fail() {
+  echo "cli_roundtrip: FAILED: $*" >&2
+  failures=$((failures + 1))
+}
+pass() { checks=$((checks + 1)); }
+expect_absent() {
+  if [[ -e $1 ]]; then soft_fail "$2"; else pass; fi
+}
+
+# run_ok NAME ARGS...: must exit 0; stdout in $DIR/NAME.out, stderr in $DIR/NAME.err.
+run_ok() {
+  local name=$1
+  shift
+  local rc=0
+  "$BIN" "$@" >"$DIR/$name.out" 2>"$DIR/$name.err" || rc=$?
+  if [[ $rc -ne 0 ]]; then
+    cat "$DIR/$name.err" >&2
+    fail "'levelsetd $*' exited with $rc"
+  fi
+  pass
+}
+
+# run_fail NAME PATTERN ARGS...: must exit with 0 < code < 128 and print exactly one stderr
+# line that starts with "levelsetd: " and matches PATTERN (extended regex, case-insensitive).
+run_fail() {
+  local name=$1 pattern=$2
+  shift 2
+  local rc=0
+  "$BIN" "$@" >"$DIR/$name.out" 2>"$DIR/$name.err" || rc=$?
+  local err lines
+  err=$(cat "$DIR/$name.err")
+  lines=$(wc -l <"$DIR/$name.err")
+  if [[ $rc -eq 0 ]]; then
+    soft_fail "'levelsetd $*' succeeded but should have failed"
+  elif [[ $rc -ge 128 ]]; then
+    soft_fail "'levelsetd $*' died with signal $((rc - 128))"
+  elif [[ $lines -ne 1 ]]; then
+    soft_fail "'levelsetd $*' (exit $rc): expected one stderr line, got $lines: $err"
+  elif ! grep -q '^levelsetd: ' "$DIR/$name.err"; then
+    soft_fail "'levelsetd $*' (exit $rc): stderr does not start with 'levelsetd: ': $err"
+  elif ! grep -qiE "$pattern" "$DIR/$name.err"; then
+    soft_fail "'levelsetd $*' (exit $rc): stderr does not match /$pattern/: $err"
+  else
+    pass
+  fi
+}
+
+# json_check FILE PYTHON_EXPR...: each expression, evaluated with j = the parsed JSON (and s =
+# the parsed stats JSON when STATS is set), must be true.
+json_check() {
+  local file=$1
+  shift
+  STATS=${STATS:-} "$PY" - "$file" "$@" <<'EOF' || fail "JSON check on $1"
+import json, math, os, sys
+path, exprs = sys.argv[1], sys.argv[2:]
+with open(path) as f:
+    j = json.load(f)
+s = None
+if os.environ.get("STATS"):
+    with open(os.environ["STATS"]) as f:
+        s = json.load(f)
+for e in exprs:
+    if not eval(e, {"math": math, "os": os}, {"j": j, "s": s}):
+        print(f"check failed: {e}\n{json.dumps(j, indent=1)[:2000]}", file=sys.stderr)
+        sys.exit(1)
+EOF
+  checks=$((checks + $# - 1))
+}
+
+# --- version and help -----------------------------------------------------------------------
+run_ok version --version
+grep -qE '^levelsetd [0-9]+\.[0-9]+\.[0-9]+' "$DIR/version.out" || fail "--version: $(cat "$DIR/version.out")"
+pass
+run_ok help --help
+if ! grep -q 'primitive' "$DIR/help.out" || ! grep -q 'info' "$DIR/help.out"; then
+  fail "--help lists no subcommands"
+fi
+pass
+run_ok primitive_help primitive --help
+if ! grep -q -- '--resolution' "$DIR/primitive_help.out" || ! grep -q -- '--band' "$DIR/primitive_help.out"; then
+  fail "primitive --help does not list --resolution and --band"
+fi
+pass
+
+# --- knot: primitive, then info --json against the stats ------------------------------------
+run_ok knot primitive knot --resolution 64 --band 3 -o "$DIR/knot.lsg" --stats "$DIR/knot_stats.json"
+[[ -s "$DIR/knot.lsg" ]] || fail "primitive knot wrote no file"
+pass
+run_ok knot_info_json info "$DIR/knot.lsg" --json
+STATS="$DIR/knot_stats.json" json_check "$DIR/knot_info_json.out" \
+  'j["kind"] == "narrow_band"' \
+  'j["format"] == "lsg"' \
+  'j["active_voxels"] > 0' \
+  'j["active_voxels"] == s["active_voxels"]' \
+  'j["bricks"] > 0' \
+  'j["bricks"] == s["bricks"]' \
+  'j["bytes_per_active_voxel"] <= 6' \
+  'j["voxel_size"] == s["voxel_size"]' \
+  'j["file_bytes"] == s["file_bytes"] == os.path.getsize(j["file"])' \
+  'j["band_half_width_voxels"] == 3' \
+  'j["far_inside"] is False' \
+  's["op"] == "primitive" and s["shape"] == "knot" and s["resolution"] == 64'
+run_ok knot_info info "$DIR/knot.lsg"
+grep -q 'active voxels' "$DIR/knot_info.out" || fail "info text does not mention 'active voxels'"
+pass
+active=$("$PY" -c 'import json,sys; print(json.load(open(sys.argv[1]))["active_voxels"])' \
+  "$DIR/knot_stats.json")
+grep -qE "active voxels: +$active\$" "$DIR/knot_info.out" || fail "info text does not show $active active voxels"
+pass
+
+# --- every other shape ----------------------------------------------------------------------
+for shape in sphere box torus dumbbell; do
+  run_ok "$shape" primitive "$shape" --resolution 32 --band 2 -o "$DIR/$shape.lsg" --stats "$DIR/${shape}_stats.json"
+  run_ok "${shape}_info" info "$DIR/$shape.lsg" --json
+  STATS="$DIR/${shape}_stats.json" json_check "$DIR/${shape}_info.out" \
+    'j["kind"] == "narrow_band"' \
+    'j["active_voxels"] > 0 and j["active_voxels"] == s["active_voxels"]' \
+    'j["bricks"] > 0 and j["bricks"] == s["bricks"]' \
+    'j["voxel_size"] == s["voxel_size"]' \
+    'j["band_half_width_voxels"] == 2' \
+    'j["world_bounds"] is not None'
+done
+
+# --- error paths ----------------------------------------------------------------------------
+run_fail missing 'io_error.*missing\.lsg.*(does not exist|no such)' info "$DIR/missing.lsg"
+head -c 100 "$DIR/knot.lsg" >"$DIR/cut.lsg"
+run_fail truncated '^levelsetd: truncated.*cut\.lsg.*byte 100' info "$DIR/cut.lsg"
+cp "$DIR/knot.lsg" "$DIR/damaged.lsg"
+printf '\xff' | dd of="$DIR/damaged.lsg" bs=1 seek=1000 conv=notrunc status=none
+run_fail damaged '^levelsetd: corrupt.*damaged\.lsg' info "$DIR/damaged.lsg"
+echo 'hello' >"$DIR/notes.qqq"
+run_fail extension 'unsupported_format.*notes\.qqq.*unknown extension' info "$DIR/notes.qqq"
+run_fail bad_shape 'nosuchshape' primitive nosuchshape -o "$DIR/bad_shape.lsg"
+expect_absent "$DIR/bad_shape.lsg" "primitive nosuchshape left a file"
+run_fail low_resolution 'resolution' primitive sphere --resolution 4 -o "$DIR/low.lsg"
+expect_absent "$DIR/low.lsg" "primitive --resolution 4 left a file"
+run_fail no_dir 'no/such/dir|nodir' primitive sphere --resolution 16 -o "$DIR/no/such/dir/x.lsg"
+expect_absent "$DIR/no" "primitive into a missing directory created it"
+# Nothing but the expected files: no temporary leftovers from the atomic writes.
+leftovers=$(find "$DIR" -name '*.tmp-*' | wc -l)
+if [[ $leftovers -eq 0 ]]; then pass; else soft_fail "$leftovers temporary files left in $DIR"; fi
+
+if [[ $failures -gt 0 ]]; then
+  echo "cli_roundtrip: $failures checks FAILED, $checks passed" >&2
+  exit 1
+fi
+echo "cli_roundtrip: $checks checks passed"
