@@ -59,6 +59,13 @@ constexpr std::uint64_t brick_key(const Coord& b) {
          ((static_cast<std::uint64_t>(b.x) + off) & mask);
 }
 
+constexpr Coord brick_from_key(std::uint64_t key) {
+  constexpr std::uint64_t mask = (std::uint64_t{1} << kBrickCoordBits) - 1;
+  return {static_cast<std::int32_t>(key & mask) - kBrickCoordLimit,
+          static_cast<std::int32_t>((key >> kBrickCoordBits) & mask) - kBrickCoordLimit,
+          static_cast<std::int32_t>((key >> (2 * kBrickCoordBits)) & mask) - kBrickCoordLimit};
+}
+
 // Inclusive index-space box; empty when min > max.
 struct IndexBox {
   Coord min{1, 1, 1};

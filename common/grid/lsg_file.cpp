@@ -43,11 +43,32 @@ std::uint64_t checksum(std::string_view header120, std::string_view stored) {
   return h;
 }
 
-std::string raw_payload(const NarrowBand& band) {
+// Byte planes: all byte 0s of the n floats, then all byte 1s, ... (zstd then sees the slowly
+// varying exponent bytes together).
+void shuffle_floats(const float* src, std::size_t n, char* dst) {
+  for (std::size_t i = 0; i < n; ++i) {
+    std::uint32_t u;
+    std::memcpy(&u, &src[i], 4);
+    for (int k = 0; k < 4; ++k) dst[k * n + i] = static_cast<char>((u >> (8 * k)) & 0xff);
+  }
+}
+float unshuffle_float(const unsigned char* planes, std::size_t n, std::size_t i) {
+  const std::uint32_t u = std::uint32_t(planes[i]) | (std::uint32_t(planes[n + i]) << 8) |
+                          (std::uint32_t(planes[2 * n + i]) << 16) | (std::uint32_t(planes[3 * n + i]) << 24);
+  float f;
+  std::memcpy(&f, &u, 4);
+  return f;
+}
+
+std::uint64_t raw_size(std::uint64_t bricks, std::uint64_t voxels, bool closest_points) {
+  return bricks * kBytesPerBrick + voxels * (closest_points ? 16 : 4);
+}
+
+std::string raw_payload(const NarrowBand& band, std::span<const Vec3f> closest_points) {
   const auto bricks = band.bricks();
   const auto values = band.values();
   const std::size_t nb = bricks.size(), nv = values.size();
-  std::string raw(nb * kBytesPerBrick + nv * 4, '\0');
+  std::string raw(raw_size(nb, nv, !closest_points.empty()), '\0');
   char* p = raw.data();
   for (const Brick& b : bricks) {
     std::memcpy(p, &b.coord.x, 4);
@@ -61,11 +82,16 @@ std::string raw_payload(const NarrowBand& band) {
     std::memcpy(p, inside.words.data(), 64);
     p += 64;
   }
-  // Byte planes: all byte 0s, then all byte 1s, ...
-  for (std::size_t i = 0; i < nv; ++i) {
-    std::uint32_t u;
-    std::memcpy(&u, &values[i], 4);
-    for (int k = 0; k < 4; ++k) p[k * nv + i] = static_cast<char>((u >> (8 * k)) & 0xff);
+  shuffle_floats(values.data(), nv, p);
+  p += 4 * nv;
+  if (!closest_points.empty()) {
+    std::vector<float> planar(3 * nv);
+    for (std::size_t i = 0; i < nv; ++i) {
+      planar[i] = closest_points[i].x;
+      planar[nv + i] = closest_points[i].y;
+      planar[2 * nv + i] = closest_points[i].z;
+    }
+    shuffle_floats(planar.data(), 3 * nv, p);
   }
   return raw;
 }
@@ -119,7 +145,11 @@ std::string decompress_bounded(std::string_view stored, std::uint64_t expected, 
 std::string encode_lsg(const NarrowBand& band, const LsgWriteOptions& options) {
   if (options.compression_level < 1 || options.compression_level > 19)
     throw Error(ErrorCode::InvalidArgument, "compression_level", "must be in [1, 19]");
-  const std::string raw = raw_payload(band);
+  if (!options.closest_points.empty() && options.closest_points.size() != band.active_voxel_count())
+    throw Error(ErrorCode::InvalidArgument, "closest_points", "need one closest point per active voxel");
+  for (const Vec3f& q : options.closest_points)
+    if (!isfinite(q)) throw Error(ErrorCode::NonFinite, "closest_points", "non-finite closest point");
+  const std::string raw = raw_payload(band, options.closest_points);
   std::string out(kHeaderBytes + ZSTD_compressBound(raw.size()), '\0');
   const std::size_t stored = ZSTD_compress(out.data() + kHeaderBytes, out.size() - kHeaderBytes,
                                            raw.data(), raw.size(), options.compression_level);
@@ -130,7 +160,7 @@ std::string encode_lsg(const NarrowBand& band, const LsgWriteOptions& options) {
   put<std::uint32_t>(out, 8, kLsgVersion);
   put<std::uint32_t>(out, 12, kHeaderBytes);
   put<std::uint32_t>(out, 16, 1);
-  put<std::uint32_t>(out, 20, band.far_inside() ? 1u : 0u);
+  put<std::uint32_t>(out, 20, (band.far_inside() ? 1u : 0u) | (options.closest_points.empty() ? 0u : 2u));
   put<double>(out, 24, band.voxel_size());
   put<double>(out, 32, band.origin().x);
   put<double>(out, 40, band.origin().y);
@@ -150,7 +180,7 @@ LsgWriteResult save_lsg(const NarrowBand& band, const std::filesystem::path& pat
                         const LsgWriteOptions& options) {
   const std::string bytes = encode_lsg(band, options);
   write_file_atomically(path, bytes);
-  return {bytes.size(), band.brick_count() * kBytesPerBrick + band.active_voxel_count() * 4};
+  return {bytes.size(), raw_size(band.brick_count(), band.active_voxel_count(), !options.closest_points.empty())};
 }
 
 LsgReadResult decode_lsg(std::string_view bytes, std::string_view name, const LsgReadOptions& options) {
@@ -176,8 +206,9 @@ LsgReadResult decode_lsg(std::string_view bytes, std::string_view name, const Ls
     throw Error(ErrorCode::UnsupportedFormat, at_byte(name, 16),
                 "value type " + std::to_string(h.value_type) + " (only 1 = float32 is known)");
   const std::uint32_t flags = get<std::uint32_t>(bytes, 20);
-  if (flags > 1) corrupt(name, 20, "unknown flag bits");
+  if (flags > 3) corrupt(name, 20, "unknown flag bits");
   h.far_inside = flags & 1u;
+  h.closest_points = (flags & 2u) != 0;
   h.frame.voxel_size = get<double>(bytes, 24);
   h.frame.origin = {get<double>(bytes, 32), get<double>(bytes, 40), get<double>(bytes, 48)};
   h.frame.half_width = get<double>(bytes, 56);
@@ -215,7 +246,7 @@ LsgReadResult decode_lsg(std::string_view bytes, std::string_view name, const Ls
     throw Error(ErrorCode::LimitExceeded, at_byte(name, 64),
                 std::to_string(h.bricks) + " bricks / " + std::to_string(h.active_voxels) +
                     " active voxels exceed the limits");
-  if (h.raw_bytes != h.bricks * kBytesPerBrick + h.active_voxels * 4)
+  if (h.raw_bytes != raw_size(h.bricks, h.active_voxels, h.closest_points))
     corrupt(name, 80, "raw payload size does not match brick and voxel counts");
   if (h.raw_bytes > options.max_raw_bytes)
     throw Error(ErrorCode::LimitExceeded, at_byte(name, 80),
@@ -251,12 +282,21 @@ LsgReadResult decode_lsg(std::string_view bytes, std::string_view name, const Ls
   std::vector<float> values(nv);
   const unsigned char* planes = reinterpret_cast<const unsigned char*>(p + kBytesPerBrick * nb);
   for (std::size_t i = 0; i < nv; ++i) {
-    const std::uint32_t u = std::uint32_t(planes[i]) | (std::uint32_t(planes[nv + i]) << 8) |
-                            (std::uint32_t(planes[2 * nv + i]) << 16) |
-                            (std::uint32_t(planes[3 * nv + i]) << 24);
-    std::memcpy(&values[i], &u, 4);
+    values[i] = unshuffle_float(planes, nv, i);
     if (!std::isfinite(values[i]))
       corrupt_payload(name, kBytesPerBrick * nb + i, "non-finite value at voxel " + std::to_string(i));
+  }
+  std::vector<Vec3f> closest_points;
+  if (h.closest_points) {
+    const unsigned char* cp = planes + 4 * nv;
+    closest_points.resize(nv);
+    for (std::size_t i = 0; i < nv; ++i) {
+      closest_points[i] = {unshuffle_float(cp, 3 * nv, i), unshuffle_float(cp, 3 * nv, nv + i),
+                           unshuffle_float(cp, 3 * nv, 2 * nv + i)};
+      if (!isfinite(closest_points[i]))
+        corrupt_payload(name, kBytesPerBrick * nb + 4 * nv + i,
+                        "non-finite closest point at voxel " + std::to_string(i));
+    }
   }
   for (std::size_t i = 0; i < nb; ++i) {
     const BrickRecord& b = bricks[i];
@@ -268,7 +308,7 @@ LsgReadResult decode_lsg(std::string_view bytes, std::string_view name, const Ls
   }
   options.progress.step(0.9, "index");
   LsgReadResult result{NarrowBand::assemble(h.frame, std::move(bricks), std::move(values), h.far_inside),
-                       h, bytes.size()};
+                       h, bytes.size(), std::move(closest_points)};
   return result;
 }
 

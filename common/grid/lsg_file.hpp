@@ -3,13 +3,14 @@
 // Layout (little-endian):
 //   header, 128 bytes:
 //     0  magic "\x89LSG\r\n\x1a\n"       8  u32 version (1)      12 u32 header bytes (128)
-//     16 u32 value type (1 = float32)   20 u32 flags (bit 0: far_inside)
+//     16 u32 value type (1 = float32)   20 u32 flags (bit 0: far_inside, bit 1: closest points)
 //     24 f64 voxel size  32 f64[3] origin  56 f64 half-width (voxels)
 //     64 u64 bricks  72 u64 active voxels  80 u64 payload bytes raw  88 u64 payload bytes stored
 //     96..119 reserved (zero)           120 u64 XXH3-64 of bytes [0,120) and the stored payload
 //   payload, zstd-compressed: brick coords (i32 x3 per brick), active masks (64 B per brick),
 //     inside masks (64 B per brick), values (f32 per active voxel, byte-shuffled into 4 planes
-//     so zstd sees slowly varying exponent bytes together).
+//     so zstd sees slowly varying exponent bytes together); with flag bit 1, then the closest
+//     surface point of every active voxel (all x, all y, all z as f32, byte-shuffled likewise).
 // Reading checks, in order: size >= header, magic (UnsupportedFormat), version (newer:
 // UnsupportedVersion), header fields, truncation (Truncated), checksum (Corrupt), payload size
 // and structure (sorted unique bricks, popcounts, finite values, signs agree: Corrupt).
@@ -20,6 +21,8 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <span>
+#include <vector>
 #include <string>
 #include <string_view>
 
@@ -32,6 +35,8 @@ inline constexpr std::uint32_t kLsgVersion = 1;
 
 struct LsgWriteOptions {
   int compression_level = 3;  // zstd level, 1..19
+  // Optional extra field: one closest surface point per active voxel, in band value order.
+  std::span<const Vec3f> closest_points;
 };
 
 struct LsgReadOptions {
@@ -45,6 +50,7 @@ struct LsgHeader {
   std::uint32_t version = kLsgVersion;
   std::uint32_t value_type = 1;
   bool far_inside = false;
+  bool closest_points = false;
   GridFrame frame;
   std::uint64_t bricks = 0;
   std::uint64_t active_voxels = 0;
@@ -56,6 +62,7 @@ struct LsgReadResult {
   NarrowBand band;
   LsgHeader header;
   std::uint64_t file_bytes = 0;
+  std::vector<Vec3f> closest_points;  // empty unless the file carries them
 };
 
 struct LsgWriteResult {

@@ -56,6 +56,8 @@ TEST(Coord, KeysSortInZYXOrder) {
   EXPECT_LT(brick_key(b), brick_key(c));  // smaller z first
   EXPECT_LT(brick_key(Coord{-1, 0, 0}), brick_key(Coord{0, 0, 0}));
   EXPECT_TRUE(brick_in_range(Coord{-kBrickCoordLimit, 0, kBrickCoordLimit - 1}));
+  for (const Coord c : {a, b, c, Coord{-kBrickCoordLimit, kBrickCoordLimit - 1, 0}})
+    EXPECT_EQ(brick_from_key(brick_key(c)), c);
   EXPECT_FALSE(brick_in_range(Coord{kBrickCoordLimit, 0, 0}));
 }
 

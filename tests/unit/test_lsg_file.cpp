@@ -15,6 +15,7 @@
 #include <cmath>
 #include <cstdint>
 #include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <functional>
@@ -27,6 +28,7 @@
 
 #include "core/error.hpp"
 #include "grid/lsg_file.hpp"
+#include "shape_band.hpp"
 #include "grid/narrow_band.hpp"
 #include "shape_band.hpp"
 
@@ -366,11 +368,11 @@ TEST(LsgFileRoundTrip, SetValueBandWithNegativeCoordinates) {
 TEST(LsgFileRoundTrip, EveryCompressionLevelDecodesTheSame) {
   const NarrowBand band = test::make_shape_band("dumbbell", 32).band;
   for (int level : {1, 3, 9, 19}) {
-    const LsgReadResult r = decode_lsg(encode_lsg(band, {level}), kName);
+    const LsgReadResult r = decode_lsg(encode_lsg(band, {level, {}}), kName);
     EXPECT_TRUE(r.band.identical(band)) << "level " << level;
   }
-  EXPECT_THROW(encode_lsg(band, {0}), Error);
-  EXPECT_THROW(encode_lsg(band, {20}), Error);
+  EXPECT_THROW(encode_lsg(band, {0, {}}), Error);
+  EXPECT_THROW(encode_lsg(band, {20, {}}), Error);
 }
 
 TEST(LsgFileRoundTrip, ReportsProgressAndHonoursCancellation) {
@@ -403,7 +405,7 @@ TEST(LsgFileFormat, IndependentEncoderMatchesEncodeLsgByteForByte) {
     for (int level : {1, 3, 19}) {
       SCOPED_TRACE(testing::Message() << band.active_voxel_count() << " voxels, level " << level);
       const std::string mine = craft(raw_band_of(band), level);
-      const std::string theirs = encode_lsg(band, {level});
+      const std::string theirs = encode_lsg(band, {level, {}});
       EXPECT_EQ(mine.size(), theirs.size());
       EXPECT_TRUE(mine == theirs) << "independent encoder and encode_lsg disagree";
       const LsgReadResult r = decode_lsg(mine, kName);
@@ -514,7 +516,7 @@ TEST(LsgFileRefuse, OneFlippedBitAtEveryByte) {
       std::optional<std::uint64_t> at = 120;
       if (i < 8) at = 0;
       if (i >= 8 && i < 24) at = i & ~std::size_t{3};
-      if (i == 20 && bit == 0) at = 120;  // flags 1 (far_inside) is valid: checksum fails
+      if (i == 20 && bit <= 1) at = 120;  // flags 1 and 2 are valid: checksum fails
       if (i >= 88 && i < 96) at = std::nullopt;  // stored size: truncated or trailing bytes
       if (i >= 96 && i < 120) at = i;  // reserved bytes are checked before the checksum
       EXPECT_TRUE(refused(bad, expect, at)) << "byte " << i << " bit " << bit;
@@ -539,7 +541,7 @@ TEST(LsgFileRefuse, HeaderFieldsWithValidChecksum) {
   EXPECT_TRUE(refused(craft(r, 3, [](Header& h) { h.header_bytes = 256; }), ErrorCode::Corrupt, 12));
   EXPECT_TRUE(refused(craft(r, 3, [](Header& h) { h.value_type = 2; }), ErrorCode::UnsupportedFormat, 16));
   EXPECT_TRUE(refused(craft(r, 3, [](Header& h) { h.value_type = 0; }), ErrorCode::UnsupportedFormat, 16));
-  for (std::uint32_t flags : {2u, 3u, 0x100u, 0x80000000u})
+  for (std::uint32_t flags : {4u, 5u, 0x100u, 0x80000000u})
     EXPECT_TRUE(refused(craft(r, 3, [&](Header& h) { h.flags = flags; }), ErrorCode::Corrupt, 20)) << flags;
   for (std::size_t i = 0; i < 24; ++i)
     EXPECT_TRUE(refused(craft(r, 3, [&](Header& h) { h.reserved[i] = 1; }), ErrorCode::Corrupt, 96 + i));
@@ -865,6 +867,45 @@ TEST(LsgFileLoad, MissingFileDirectoryAndEmptyFile) {
   EXPECT_EQ(bad->code(), ErrorCode::Corrupt);
   EXPECT_EQ(bad->where(), at_byte((dir / "bad.lsg").string(), 120));
   fs::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace levelset
+
+namespace levelset {
+namespace {
+
+TEST(LsgFileRoundTrip, ClosestPointsFieldSurvivesBitExactly) {
+  const auto sb = test::make_shape_band("torus", 32);
+  std::vector<Vec3f> points(sb.band.active_voxel_count());
+  std::size_t i = 0;
+  sb.band.for_each_active_world([&](const Coord&, const Vec3d& p, float) {
+    points[i++] = {float(p.x * 0.5), float(p.y - 1.0), float(p.z) + 1e-7f * float(i)};
+  });
+  LsgWriteOptions options;
+  options.closest_points = points;
+  const std::string bytes = encode_lsg(sb.band, options);
+  const LsgReadResult r = decode_lsg(bytes, "cp.lsg");
+  EXPECT_TRUE(r.header.closest_points);
+  EXPECT_TRUE(r.band.identical(sb.band));
+  ASSERT_EQ(r.closest_points.size(), points.size());
+  EXPECT_EQ(std::memcmp(r.closest_points.data(), points.data(), points.size() * sizeof(Vec3f)), 0);
+  // Without the field the flag is clear and nothing extra comes back.
+  const LsgReadResult plain = decode_lsg(encode_lsg(sb.band), "plain.lsg");
+  EXPECT_FALSE(plain.header.closest_points);
+  EXPECT_TRUE(plain.closest_points.empty());
+}
+
+TEST(LsgFileRefuse, ClosestPointsOfTheWrongCountOrNonFinite) {
+  const auto sb = test::make_shape_band("sphere", 24);
+  std::vector<Vec3f> points(sb.band.active_voxel_count() - 1);
+  LsgWriteOptions options;
+  options.closest_points = points;
+  EXPECT_THROW(encode_lsg(sb.band, options), Error);
+  points.resize(sb.band.active_voxel_count());
+  points[3].y = std::nanf("");
+  options.closest_points = points;
+  EXPECT_THROW(encode_lsg(sb.band, options), Error);
 }
 
 }  // namespace

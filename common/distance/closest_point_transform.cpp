@@ -1,0 +1,237 @@
+#include "distance/closest_point_transform.hpp"
+
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <string>
+
+#include <tbb/parallel_for.h>
+
+#include "core/error.hpp"
+#include "distance/brick_triangle_lists.hpp"
+#include "distance/inside_masks.hpp"
+#include "distance/orient_faces.hpp"
+#include "distance/winding_number.hpp"
+#include "geometry/point_triangle.hpp"
+
+namespace levelset {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
+
+// Per-brick result before packing.
+struct BrickDistances {
+  BrickMask active;
+  std::vector<float> distance;       // unsigned, packed in active order
+  std::vector<Vec3f> closest_point;  // packed in active order (when requested)
+};
+
+void check_budget(const TriangleMesh& mesh, const CptOptions& options) {
+  if (mesh.triangles.empty())
+    throw Error(ErrorCode::InvalidArgument, "mesh", "the mesh has no triangles");
+  const BBox box = mesh.bounds();
+  if (!isfinite(box.min) || !isfinite(box.max)) {
+    for (std::size_t i = 0; i < mesh.vertices.size(); ++i)
+      if (!isfinite(mesh.vertices[i]))
+        throw Error(ErrorCode::NonFinite, "vertex " + std::to_string(i), "non-finite coordinate");
+  }
+  const double h = options.frame.voxel_size;
+  const double pad = 2.0 * (options.frame.half_width + 1.0);
+  double voxels = 1.0;
+  for (int a = 0; a < 3; ++a) voxels *= std::ceil((box.max[a] - box.min[a]) / h) + pad;
+  if (!(voxels <= double(options.max_domain_voxels)))
+    throw Error(ErrorCode::LimitExceeded, "mesh",
+                "the mesh spans " + std::to_string(voxels) + " voxels at voxel size " +
+                    std::to_string(h) + ", more than the voxel budget of " +
+                    std::to_string(options.max_domain_voxels) + "; increase the voxel size");
+}
+
+// Scan-converts the slab of one triangle within one brick and keeps per-voxel minima.
+void scan_triangle(const Vec3d& a, const Vec3d& b, const Vec3d& c, std::uint32_t tri,
+                   const Coord& brick, const GridFrame& frame, double band2, double* dist2,
+                   std::uint32_t* owner) {
+  const double h = frame.voxel_size;
+  const double r = frame.half_width * h * (1.0 + 1e-12) + 1e-12 * h;  // inclusive at the rim
+  const Coord o = brick_origin(brick);
+  // Voxel range of the triangle's inflated bounding box, clipped to the brick.
+  int lo[3], hi[3];
+  const Vec3d tmin = min(min(a, b), c), tmax = max(max(a, b), c);
+  for (int ax = 0; ax < 3; ++ax) {
+    lo[ax] = std::max(0, int(std::ceil((tmin[ax] - r - frame.origin[ax]) / h)) - o[ax]);
+    hi[ax] = std::min(kBrickDim - 1, int(std::floor((tmax[ax] + r - frame.origin[ax]) / h)) - o[ax]);
+    if (lo[ax] > hi[ax]) return;
+  }
+  // Slab along the dominant normal axis: |n.(p - a)| <= r bounds that coordinate per column.
+  Vec3d n = cross(b - a, c - a);
+  const double len = length(n);
+  int axis = 2;
+  if (len > 0.0) {
+    n = n / len;
+    const Vec3d an{std::abs(n.x), std::abs(n.y), std::abs(n.z)};
+    axis = an.x >= an.y ? (an.x >= an.z ? 0 : 2) : (an.y >= an.z ? 1 : 2);
+  }
+  const int u = (axis + 1) % 3, v = (axis + 2) % 3;
+  const bool slab = len > 0.0 && std::abs(n[axis]) > 1e-3;
+  for (int jv = lo[v]; jv <= hi[v]; ++jv) {
+    for (int ju = lo[u]; ju <= hi[u]; ++ju) {
+      int k0 = lo[axis], k1 = hi[axis];
+      Vec3d p;
+      p[u] = frame.origin[u] + (o[u] + ju) * h;
+      p[v] = frame.origin[v] + (o[v] + jv) * h;
+      if (slab) {
+        // Plane coordinate along the axis at this column, then +- r / |n_axis|.
+        const double along = a[axis] - (n[u] * (p[u] - a[u]) + n[v] * (p[v] - a[v])) / n[axis];
+        const double spread = r / std::abs(n[axis]);
+        k0 = std::max(k0, int(std::ceil((along - spread - frame.origin[axis]) / h)) - o[axis]);
+        k1 = std::min(k1, int(std::floor((along + spread - frame.origin[axis]) / h)) - o[axis]);
+      }
+      for (int k = k0; k <= k1; ++k) {
+        p[axis] = frame.origin[axis] + (o[axis] + k) * h;
+        const double d2 = closest_point_on_triangle(p, a, b, c).distance_squared;
+        Coord l;
+        l[axis] = k;
+        l[u] = ju;
+        l[v] = jv;
+        const int idx = local_index(l.x, l.y, l.z);
+        if (d2 <= band2 && d2 < dist2[idx]) {
+          dist2[idx] = d2;
+          owner[idx] = tri;
+        }
+      }
+    }
+  }
+}
+
+}  // namespace
+
+CptResult closest_point_transform(const TriangleMesh& mesh, const CptOptions& options) {
+  const auto t_start = Clock::now();
+  NarrowBand validate(options.frame);
+  (void)validate;
+  check_budget(mesh, options);
+  CptResult result;
+  result.triangles = mesh.triangles.size();
+
+  auto t = Clock::now();
+  const OrientResult oriented = orient_faces(mesh, OrientOptions{});
+  result.faces_flipped = oriented.faces_flipped;
+  result.seconds.orient = since(t);
+  options.progress.step(0.05, "orient");
+
+  t = Clock::now();
+  BinTrianglesOptions bin;
+  bin.frame = options.frame;
+  bin.margin = options.frame.half_width * options.frame.voxel_size;
+  bin.progress = options.progress;
+  const BrickTriangleLists lists = bin_triangles_to_bricks(mesh, bin);
+  result.brick_triangle_pairs = lists.triangles.size();
+  result.seconds.bin = since(t);
+  options.progress.step(0.15, "bin");
+
+  // Unsigned distances per brick (the mesh as given: orientation does not change distances).
+  t = Clock::now();
+  const std::size_t nb = lists.bricks.size();
+  std::vector<BrickDistances> per_brick(nb);
+  const double r = options.frame.half_width * options.frame.voxel_size;
+  const double band2 = r * r;
+  const std::size_t batch = 512;
+  for (std::size_t start = 0; start < nb; start += batch) {
+    const std::size_t end = std::min(nb, start + batch);
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(start, end, 4),
+                      [&](const tbb::blocked_range<std::size_t>& range) {
+      double dist2[kBrickVoxels];
+      std::uint32_t owner[kBrickVoxels];
+      for (std::size_t i = range.begin(); i != range.end(); ++i) {
+        std::fill(dist2, dist2 + kBrickVoxels, std::numeric_limits<double>::infinity());
+        for (std::uint64_t k = lists.offsets[i]; k < lists.offsets[i + 1]; ++k) {
+          const std::uint32_t tri = lists.triangles[k];
+          const auto& f = mesh.triangles[tri];
+          scan_triangle(mesh.vertices[f[0]], mesh.vertices[f[1]], mesh.vertices[f[2]], tri,
+                        lists.bricks[i], options.frame, band2, dist2, owner);
+        }
+        BrickDistances& out = per_brick[i];
+        const Coord o = brick_origin(lists.bricks[i]);
+        for (int n = 0; n < kBrickVoxels; ++n) {
+          if (!(dist2[n] <= band2)) continue;
+          out.active.set(n);
+          out.distance.push_back(static_cast<float>(std::sqrt(dist2[n])));
+          if (options.closest_points) {
+            const auto& f = mesh.triangles[owner[n]];
+            const Coord l = local_coord(n);
+            const Vec3d p = options.frame.origin +
+                            Vec3d{double(o.x + l.x), double(o.y + l.y), double(o.z + l.z)} *
+                                options.frame.voxel_size;
+            const Vec3d q = closest_point_on_triangle(p, mesh.vertices[f[0]], mesh.vertices[f[1]],
+                                                      mesh.vertices[f[2]]).point;
+            out.closest_point.push_back({float(q.x), float(q.y), float(q.z)});
+          }
+        }
+      }
+    });
+    options.progress.step(0.15 + 0.55 * double(end) / double(nb), "distance");
+  }
+  result.seconds.distance = since(t);
+
+  // Signs: winding numbers of the consistently oriented mesh, one mask per brick.
+  t = Clock::now();
+  const WindingNumberTree tree = build_winding_tree(oriented.mesh);
+  InsideMasksOptions sign_options;
+  sign_options.frame = options.frame;
+  sign_options.progress = options.progress;
+  const InsideMasksResult signs = compute_inside_masks(oriented.mesh, tree, lists, sign_options);
+  result.winding_queries = signs.winding_queries;
+  result.seconds.sign = since(t);
+  options.progress.step(0.9, "sign");
+
+  // Pack bricks with active voxels in key order (lists are sorted by key).
+  t = Clock::now();
+  std::vector<BrickRecord> records;
+  std::vector<std::uint64_t> offsets;
+  std::uint64_t total = 0;
+  for (std::size_t i = 0; i < nb; ++i) {
+    if (per_brick[i].active.none()) continue;
+    records.push_back({lists.bricks[i], per_brick[i].active, signs.inside[i]});
+    offsets.push_back(total);
+    total += per_brick[i].distance.size();
+  }
+  if (total >= 0xffffffffull)
+    throw Error(ErrorCode::LimitExceeded, "band", "more than 2^32-1 active voxels");
+  std::vector<float> values(total);
+  if (options.closest_points) result.closest_points.resize(total);
+  std::vector<std::size_t> kept;
+  kept.reserve(records.size());
+  for (std::size_t i = 0; i < nb; ++i)
+    if (!per_brick[i].active.none()) kept.push_back(i);
+  tbb::parallel_for(std::size_t(0), kept.size(), [&](std::size_t j) {
+    const BrickDistances& bd = per_brick[kept[j]];
+    const BrickMask& inside = records[j].inside;
+    float* dst = values.data() + offsets[j];
+    std::size_t k = 0;
+    bd.active.for_each_set([&](int n) {
+      dst[k] = inside.test(n) ? -bd.distance[k] : bd.distance[k];
+      ++k;
+    });
+    if (options.closest_points)
+      std::copy(bd.closest_point.begin(), bd.closest_point.end(),
+                result.closest_points.begin() + std::ptrdiff_t(offsets[j]));
+  });
+  // A voxel exactly on the surface has distance 0: keep its sign bit consistent with the
+  // value's sign (-0 < 0 is false), as the band requires.
+  for (std::size_t j = 0; j < kept.size(); ++j) {
+    const float* v = values.data() + offsets[j];
+    std::size_t k = 0;
+    records[j].active.for_each_set([&](int n) {
+      if (records[j].inside.test(n) && !(v[k] < 0.0f)) records[j].inside.reset(n);
+      ++k;
+    });
+  }
+  result.band = NarrowBand::assemble(options.frame, std::move(records), std::move(values), false);
+  result.seconds.assemble = since(t);
+  result.seconds.total = since(t_start);
+  options.progress.step(1.0, "done");
+  return result;
+}
+
+}  // namespace levelset
