@@ -14,9 +14,9 @@
 
 namespace {
 
-void add_threads_option(CLI::App* sub, int& threads) {
-  sub->add_option("--threads", threads, "Worker threads (default: all cores)")
-      ->check(CLI::Range(1, 1024));
+void add_common_options(CLI::App* sub, int& threads, std::string& stats) {
+  sub->add_option("--threads", threads, "Worker threads (default: all cores)")->check(CLI::Range(1, 1024));
+  sub->add_option("--stats", stats, "Write timings and sizes as JSON to FILE (or - for stdout)");
 }
 
 }  // namespace
@@ -25,6 +25,7 @@ int main(int argc, char** argv) {
   CLI::App app{"levelsetd: narrow-band level-set computation (batch subcommands; daemon to come)"};
   app.set_version_flag("--version", std::string("levelsetd ") + LEVELSET_VERSION);
   app.require_subcommand(1);
+  int threads = 0;
 
   levelset::cli::InfoArgs info;
   CLI::App* info_cmd = app.add_subcommand("info", "Print what a mesh, point cloud or .lsg file holds");
@@ -42,8 +43,37 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(8, 1 << 15));
   prim_cmd->add_option("--band,-b", prim.band, "Band half-width in voxels")->check(CLI::Range(1.0, 64.0));
   prim_cmd->add_option("-o,--output", prim.output, "Output .lsg file")->required();
-  prim_cmd->add_option("--stats", prim.stats, "Write timing statistics as JSON to FILE (or - for stdout)");
-  add_threads_option(prim_cmd, prim.threads);
+  add_common_options(prim_cmd, threads, prim.stats);
+
+  levelset::cli::CptArgs cpt;
+  CLI::App* cpt_cmd = app.add_subcommand("cpt", "Closest point transform: triangle mesh -> signed narrow band");
+  cpt_cmd->add_option("mesh", cpt.mesh, "Input mesh (.off .tria .ply .obj .stl)")->required();
+  auto* res_opt = cpt_cmd->add_option("--resolution,-r", cpt.resolution,
+                                      "Voxels along the longest side of the bounding box padded by the band")
+                      ->check(CLI::Range(8, 1 << 15));
+  auto* vs_opt = cpt_cmd->add_option("--voxel-size", cpt.voxel_size, "Voxel size in mesh units")
+                     ->check(CLI::PositiveNumber);
+  res_opt->excludes(vs_opt);
+  cpt_cmd->add_option("--band,-b", cpt.band, "Band half-width in voxels")->check(CLI::Range(1.0, 64.0));
+  cpt_cmd->add_flag("--closest-points", cpt.closest_points, "Store the closest surface point per voxel");
+  cpt_cmd->add_option("-o,--output", cpt.output, "Output .lsg file")->required();
+  add_common_options(cpt_cmd, threads, cpt.stats);
+
+  levelset::cli::RedistanceArgs redist;
+  CLI::App* redist_cmd = app.add_subcommand("redistance", "Restore the distance property (|grad u| = 1)");
+  redist_cmd->add_option("input", redist.input, "Input .lsg")->required();
+  redist_cmd->add_option("--method", redist.method, "sweep (fast sweeping) or march (fast marching)")
+      ->check(CLI::IsMember({"sweep", "march"}));
+  redist_cmd->add_option("--band,-b", redist.band, "New band half-width in voxels (default: keep)")
+      ->check(CLI::Range(1.0, 64.0));
+  redist_cmd->add_option("-o,--output", redist.output, "Output .lsg file")->required();
+  add_common_options(redist_cmd, threads, redist.stats);
+
+  levelset::cli::SampleArgs sample;
+  CLI::App* sample_cmd = app.add_subcommand("sample", "Trilinearly interpolated values at points");
+  sample_cmd->add_option("input", sample.input, "Input .lsg")->required();
+  sample_cmd->add_option("--points", sample.points, "Points (.xyz .xyzn .pwn .ply)")->required();
+  sample_cmd->add_option("-o,--output", sample.output, "Output text file, one value per line (default: stdout)");
 
   try {
     app.parse(argc, argv);
@@ -54,12 +84,14 @@ int main(int argc, char** argv) {
   }
 
   std::optional<tbb::global_control> limit;
-  const int threads = prim.threads;
   if (threads > 0) limit.emplace(tbb::global_control::max_allowed_parallelism, threads);
 
   try {
     if (*info_cmd) return levelset::cli::run_info(info);
     if (*prim_cmd) return levelset::cli::run_primitive(prim);
+    if (*cpt_cmd) return levelset::cli::run_cpt(cpt);
+    if (*redist_cmd) return levelset::cli::run_redistance(redist);
+    if (*sample_cmd) return levelset::cli::run_sample(sample);
   } catch (const levelset::Error& e) {
     std::fprintf(stderr, "levelsetd: %s\n", e.what());
     return 1;

@@ -11,6 +11,7 @@
 #include "distance/brick_triangle_lists.hpp"
 #include "distance/inside_masks.hpp"
 #include "distance/orient_faces.hpp"
+#include "distance/unique_faces.hpp"
 #include "distance/winding_number.hpp"
 #include "geometry/point_triangle.hpp"
 
@@ -87,14 +88,19 @@ void scan_triangle(const Vec3d& a, const Vec3d& b, const Vec3d& c, std::uint32_t
         k0 = std::max(k0, int(std::ceil((along - spread - frame.origin[axis]) / h)) - o[axis]);
         k1 = std::min(k1, int(std::floor((along + spread - frame.origin[axis]) / h)) - o[axis]);
       }
+      Coord l;
+      l[u] = ju;
+      l[v] = jv;
       for (int k = k0; k <= k1; ++k) {
         p[axis] = frame.origin[axis] + (o[axis] + k) * h;
-        const double d2 = closest_point_on_triangle(p, a, b, c).distance_squared;
-        Coord l;
         l[axis] = k;
-        l[u] = ju;
-        l[v] = jv;
         const int idx = local_index(l.x, l.y, l.z);
+        // The plane distance bounds the triangle distance from below: skip hopeless voxels.
+        if (slab) {
+          const double pd = dot(n, p - a);
+          if (pd * pd >= dist2[idx]) continue;
+        }
+        const double d2 = closest_point_on_triangle(p, a, b, c).distance_squared;
         if (d2 <= band2 && d2 < dist2[idx]) {
           dist2[idx] = d2;
           owner[idx] = tri;
@@ -115,7 +121,8 @@ CptResult closest_point_transform(const TriangleMesh& mesh, const CptOptions& op
   result.triangles = mesh.triangles.size();
 
   auto t = Clock::now();
-  const OrientResult oriented = orient_faces(mesh, OrientOptions{});
+  // Sign mesh: every face once, then consistently oriented (distances use the mesh as given).
+  const OrientResult oriented = orient_faces(unique_faces(mesh).mesh, OrientOptions{});
   result.faces_flipped = oriented.faces_flipped;
   result.seconds.orient = since(t);
   options.progress.step(0.05, "orient");

@@ -18,9 +18,35 @@ struct PrimitiveArgs {
   int resolution = 256;
   double band = 3.0;
   std::string output;
-  int threads = 0;
   std::string stats;
 };
 int run_primitive(const PrimitiveArgs& args);
+
+struct CptArgs {
+  std::string mesh;
+  int resolution = 256;
+  double voxel_size = 0.0;  // > 0 overrides resolution
+  double band = 3.0;
+  bool closest_points = false;
+  std::string output;
+  std::string stats;
+};
+int run_cpt(const CptArgs& args);
+
+struct RedistanceArgs {
+  std::string input;
+  std::string method = "sweep";
+  double band = 0.0;  // 0 = keep the input's half-width
+  std::string output;
+  std::string stats;
+};
+int run_redistance(const RedistanceArgs& args);
+
+struct SampleArgs {
+  std::string input;
+  std::string points;
+  std::string output;
+};
+int run_sample(const SampleArgs& args);
 
 }  // namespace levelset::cli

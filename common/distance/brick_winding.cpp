@@ -1,0 +1,247 @@
+#include "distance/brick_winding.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <utility>
+
+namespace levelset {
+
+namespace {
+
+// Interior voxels (local 1..6 on every axis, so all six edges lie in the brick), nearest the
+// brick centre first, ties by voxel number.
+std::array<std::uint16_t, 216> make_candidates() {
+  std::array<std::uint16_t, 216> c{};
+  int k = 0;
+  for (int n = 0; n < kBrickVoxels; ++n) {
+    const Coord l = local_coord(n);
+    if (l.x >= 1 && l.x <= 6 && l.y >= 1 && l.y <= 6 && l.z >= 1 && l.z <= 6) c[k++] = std::uint16_t(n);
+  }
+  auto dist2 = [](int n) {
+    const Coord l = local_coord(n);
+    return (2 * l.x - 7) * (2 * l.x - 7) + (2 * l.y - 7) * (2 * l.y - 7) + (2 * l.z - 7) * (2 * l.z - 7);
+  };
+  std::stable_sort(c.begin(), c.end(), [&](int a, int b) { return dist2(a) < dist2(b); });
+  return c;
+}
+const std::array<std::uint16_t, 216> kCandidates = make_candidates();
+
+// 6-neighbourhood dilation of a brick mask (word = z slice, bit = x + 8 y).
+BrickMask dilate(const BrickMask& m) {
+  constexpr std::uint64_t kNotX0 = 0xfefefefefefefefeull;  // bits with x > 0
+  constexpr std::uint64_t kNotX7 = 0x7f7f7f7f7f7f7f7full;  // bits with x < 7
+  BrickMask d;
+  for (int z = 0; z < 8; ++z) {
+    const std::uint64_t w = m.words[z];
+    std::uint64_t r = w | ((w << 1) & kNotX0) | ((w >> 1) & kNotX7) | (w << 8) | (w >> 8);
+    if (z > 0) r |= m.words[z - 1];
+    if (z < 7) r |= m.words[z + 1];
+    d.words[z] = r;
+  }
+  return d;
+}
+
+int pick_reference(const BrickMask& near) {
+  const BrickMask d1 = dilate(near);
+  const BrickMask d2 = dilate(d1);
+  for (const BrickMask* avoid : {&d2, &d1, &near})
+    for (std::uint16_t n : kCandidates)
+      if (!avoid->test(n)) return n;
+  return kCandidates[0];
+}
+
+// rel[n] for the voxels n of the block [lo, lo + s)^3: the sum of jumps along the path
+// r -> along x -> along y -> along z (r inside the block; the path stays in it).
+void propagate(const BrickCrossings& x, const Coord& r, const Coord& lo, int s, int* rel) {
+  // delta[w][line][e], line = l_u + 8 l_v with u = (w+1)%3, v = (w+2)%3.
+  const auto& dx = x.delta[0][r.y + 8 * r.z];  // the reference row
+  const int hx = lo.x + s, hy = lo.y + s, hz = lo.z + s;
+  int row[8];
+  row[r.x] = 0;
+  for (int i = r.x + 1; i < hx; ++i) row[i] = row[i - 1] + dx[i - 1];
+  for (int i = r.x - 1; i >= lo.x; --i) row[i] = row[i + 1] - dx[i];
+  int slice[8][8];  // [y][x] at z = r.z
+  for (int i = lo.x; i < hx; ++i) {
+    const auto& col = x.delta[1][r.z + 8 * i];
+    slice[r.y][i] = row[i];
+    for (int j = r.y + 1; j < hy; ++j) slice[j][i] = slice[j - 1][i] + col[j - 1];
+    for (int j = r.y - 1; j >= lo.y; --j) slice[j][i] = slice[j + 1][i] - col[j];
+  }
+  for (int j = lo.y; j < hy; ++j)
+    for (int i = lo.x; i < hx; ++i) {
+      const auto& col = x.delta[2][i + 8 * j];
+      int w = slice[j][i];
+      rel[local_index(i, j, r.z)] = w;
+      for (int k = r.z + 1; k < hz; ++k) rel[local_index(i, j, k)] = (w += col[k - 1]);
+      w = slice[j][i];
+      for (int k = r.z - 1; k >= lo.z; --k) rel[local_index(i, j, k)] = (w -= col[k]);
+    }
+}
+
+// Winding number jump from local voxel m to its neighbour m + step e_a.
+int jump(const BrickCrossings& x, const Coord& m, int a, int step) {
+  const int u = (a + 1) % 3, v = (a + 2) % 3;
+  const auto& line = x.delta[a][m[u] + 8 * m[v]];
+  return step > 0 ? line[m[a]] : -line[m[a] - 1];
+}
+
+double query(const BrickWindingContext& c, const Coord& brick, int n, std::uint64_t& queries) {
+  const Coord g = brick_origin(brick) + local_coord(n);
+  ++queries;
+  const Vec3d p = c.frame.origin + Vec3d{double(g.x), double(g.y), double(g.z)} * c.frame.voxel_size;
+  return winding_number(c.tree, p, c.beta);
+}
+
+// Does segment [a, b] meet the box [lo, hi] (slab clipping; conservative at the boundary)?
+bool segment_meets_box(const Vec3d& a, const Vec3d& b, const Vec3d& lo, const Vec3d& hi) {
+  double t0 = 0.0, t1 = 1.0;
+  for (int k = 0; k < 3; ++k) {
+    const double d = b[k] - a[k];
+    if (d == 0.0) {
+      if (a[k] < lo[k] || a[k] > hi[k]) return false;
+      continue;
+    }
+    double ta = (lo[k] - a[k]) / d, tb = (hi[k] - a[k]) / d;
+    if (ta > tb) std::swap(ta, tb);
+    t0 = std::max(t0, ta);
+    t1 = std::min(t1, tb);
+    if (t0 > t1) return false;
+  }
+  return true;
+}
+
+struct Adaptive {
+  const BrickCrossings& x;
+  const Coord& brick;
+  std::span<const OpenSegment> rims;
+  const BrickWindingContext& context;
+  std::uint64_t& queries;
+  std::array<double, kBrickVoxels> value{};
+  BrickMask known;
+  BrickMask inside;
+  int rel[kBrickVoxels];
+
+  double direct(int n) {
+    if (!known.test(n)) {
+      value[n] = query(context, brick, n, queries);
+      known.set(n);
+    }
+    return value[n];
+  }
+
+  // A voxel exactly on the surface: a neighbour off the surface plus the exact jump.
+  double surface_value(int n) {
+    const Coord c = local_coord(n);
+    for (int a = 0; a < 3; ++a)
+      for (int step : {-1, 1}) {
+        Coord m = c;
+        m[a] += step;
+        if (m[a] < 0 || m[a] >= kBrickDim) continue;
+        const int k = local_index(m.x, m.y, m.z);
+        if (!x.on_surface.test(k)) return direct(k) + jump(x, m, a, -step);
+      }
+    return direct(n);
+  }
+  double value_of(int n) { return x.on_surface.test(n) ? surface_value(n) : direct(n); }
+
+  // An open edge within s/2 voxels of the block: the continuous part is not smooth there.
+  bool rim_near(const Coord& lo, int s) const {
+    const double r = 0.5 * double(s);
+    const Vec3d blo{lo.x - r, lo.y - r, lo.z - r};
+    const Vec3d bhi{lo.x + s - 1 + r, lo.y + s - 1 + r, lo.z + s - 1 + r};
+    for (const OpenSegment& e : rims)
+      if (segment_meets_box(e[0], e[1], blo, bhi)) return true;
+    return false;
+  }
+
+  void solve(const Coord& lo, int s, int ref) {
+    if (s == 1) {
+      const int n = local_index(lo.x, lo.y, lo.z);
+      inside.assign(n, value_of(n) > 0.5);
+      return;
+    }
+    auto corner = [&](int bits) {
+      return local_index(lo.x + ((bits & 1) ? s - 1 : 0), lo.y + ((bits & 2) ? s - 1 : 0),
+                         lo.z + ((bits & 4) ? s - 1 : 0));
+    };
+    if (s == 2) {  // every voxel is a corner
+      for (int b = 0; b < 8; ++b) inside.assign(corner(b), value_of(corner(b)) > 0.5);
+      return;
+    }
+    if (!rim_near(lo, s)) {
+      // No open edge nearby: the jumps are path independent in the block and the rest of w is
+      // smooth there. Model it trilinearly from the corners; check at the block centre.
+      if (ref < 0 || x.on_surface.test(ref)) ref = corner(0);
+      propagate(x, local_coord(ref), lo, s, rel);
+      const double wr = value_of(ref);
+      double smooth[8];
+      for (int b = 0; b < 8; ++b) smooth[b] = value_of(corner(b)) - (wr + rel[corner(b)]);
+      auto model = [&](int i, int j, int k) {
+        const double tx = double(i - lo.x) / (s - 1), ty = double(j - lo.y) / (s - 1), tz = double(k - lo.z) / (s - 1);
+        double m = 0.0;
+        for (int b = 0; b < 8; ++b)
+          m += smooth[b] * ((b & 1) ? tx : 1 - tx) * ((b & 2) ? ty : 1 - ty) * ((b & 4) ? tz : 1 - tz);
+        return wr + rel[local_index(i, j, k)] + m;
+      };
+      const int c = s / 2;
+      if (std::abs(value_of(local_index(lo.x + c, lo.y + c, lo.z + c)) - model(lo.x + c, lo.y + c, lo.z + c)) <=
+          kAdaptiveTolerance) {
+        for (int k = lo.z; k < lo.z + s; ++k)
+          for (int j = lo.y; j < lo.y + s; ++j)
+            for (int i = lo.x; i < lo.x + s; ++i) inside.assign(local_index(i, j, k), model(i, j, k) > 0.5);
+        return;
+      }
+    }
+    const int half = s / 2;
+    for (int b = 0; b < 8; ++b) {
+      const Coord child{lo.x + ((b & 1) ? half : 0), lo.y + ((b & 2) ? half : 0), lo.z + ((b & 4) ? half : 0)};
+      solve(child, half, corner(b));
+    }
+  }
+};
+
+}  // namespace
+
+BrickMask inside_from_reference(std::span<const GridTriangle> triangles, std::span<const std::uint32_t> ids,
+                                const Coord& brick, const BrickWindingContext& context, BrickCrossings& x,
+                                std::uint64_t& queries) {
+  // Lines along z everywhere; along x and y only those of the path from the reference (its
+  // x-row, the y-lines of its z-slice). A reference found next to a crossing on them is
+  // replaced (those crossings now count in `near`), up to kMaxReferenceTries times.
+  constexpr int kMaxReferenceTries = 4;
+  x = BrickCrossings{};
+  LineSet done{0, 0, ~0ull};
+  brick_crossings(triangles, ids, brick, done, x);
+  int r = 0;
+  for (int attempt = 0; attempt < kMaxReferenceTries; ++attempt) {
+    r = pick_reference(x.near);
+    const Coord c = local_coord(r);
+    LineSet add{0, 0, 0};
+    add[0] = (std::uint64_t{1} << (c.y + 8 * c.z)) & ~done[0];
+    for (int i = 0; i < kBrickDim; ++i) add[1] |= std::uint64_t{1} << (c.z + 8 * i);
+    add[1] &= ~done[1];
+    if (add[0] | add[1]) {
+      brick_crossings(triangles, ids, brick, add, x);
+      done[0] |= add[0];
+      done[1] |= add[1];
+    }
+    if (!x.near.test(r)) break;
+  }
+  const double w_ref = query(context, brick, r, queries);
+  int rel[kBrickVoxels];
+  propagate(x, local_coord(r), Coord{0, 0, 0}, kBrickDim, rel);
+  BrickMask inside;
+  for (int n = 0; n < kBrickVoxels; ++n)
+    if (w_ref + rel[n] > 0.5) inside.set(n);
+  return inside;
+}
+
+BrickMask inside_adaptive(const BrickCrossings& crossings, const Coord& brick, std::span<const OpenSegment> rims,
+                          const BrickWindingContext& context, std::uint64_t& queries) {
+  Adaptive a{crossings, brick, rims, context, queries, {}, {}, {}, {}};
+  a.solve(Coord{0, 0, 0}, kBrickDim, -1);
+  return a.inside;
+}
+
+}  // namespace levelset

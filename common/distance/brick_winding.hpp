@@ -1,0 +1,63 @@
+// Winding numbers of the 512 voxels of one brick from a few tree queries plus the exact jumps
+// between adjacent voxels (grid_crossings.hpp). Used by compute_inside_masks.
+//
+// inside_from_reference
+//   For bricks away from open edges, where the winding number is constant apart from its
+//   integer jumps across the surface. One query at a reference voxel: the interior voxel
+//   nearest the brick centre that is farthest (up to two voxels) from any crossed edge, and
+//   not next to a crossing itself; every voxel then gets w_ref plus the jumps along the path
+//   reference -> along x -> along y -> along z. Only the lines of that path are computed (all
+//   64 along z, the reference's x-row and the 8 y-lines of its z-slice). For a closed mesh the
+//   result is path independent and exact up to the tree's error in w_ref (far below 1/2).
+// inside_adaptive
+//   For bricks near open edges, where w also varies continuously (the field of the open edges,
+//   Biot-Savart-like, strong only close to them). Recursive octree refinement of the brick:
+//   a block (8^3, 4^3) with no open edge within half its size (rims: the open edges near the
+//   brick, in brick-local grid coordinates) has path-independent jumps, and the rest of w is
+//   smooth in it: w = w(corner 0) + jumps + the trilinear interpolation of the corners'
+//   residuals, accepted when a direct query at the block centre agrees within
+//   kAdaptiveTolerance. Otherwise the block splits into octants (each reusing the corner inside
+//   it); 2^3 blocks are queried voxel by voxel. Voxels exactly on the surface are never
+//   queried (their direct value is the mean of the two sides); they take a neighbour's value
+//   plus the exact jump, following the perturbation convention. Cost: 9 queries per brick where
+//   the field is smooth, one per voxel within ~1-3 voxels of an open edge. Measured on CGAL's
+//   elephant-with-holes (1353 open edges) at 512^3: 114 queries per brick on average; all
+//   voxels with |w - 1/2| > 0.1 agree with a direct query, 0.006% of those closer do not.
+// Output of both: bit n set when w > 1/2; queries counts the tree evaluations made.
+// Threading: pure; call concurrently for different bricks. Errors: none.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <span>
+
+#include "distance/grid_crossings.hpp"
+#include "distance/winding_number.hpp"
+#include "grid/brick_mask.hpp"
+#include "grid/coord.hpp"
+#include "grid/narrow_band.hpp"
+
+namespace levelset {
+
+inline constexpr double kAdaptiveTolerance = 0.1;
+
+struct BrickWindingContext {
+  const WindingNumberTree& tree;
+  const GridFrame& frame;
+  double beta = 2.0;
+};
+
+// Computes the crossings it needs into `scratch`.
+BrickMask inside_from_reference(std::span<const GridTriangle> triangles, std::span<const std::uint32_t> ids,
+                                const Coord& brick, const BrickWindingContext& context, BrickCrossings& scratch,
+                                std::uint64_t& queries);
+
+// `crossings`: all lines (kAllLines).
+
+
+using OpenSegment = std::array<Vec3d, 2>;
+
+BrickMask inside_adaptive(const BrickCrossings& crossings, const Coord& brick, std::span<const OpenSegment> rims,
+                          const BrickWindingContext& context, std::uint64_t& queries);
+
+}  // namespace levelset

@@ -1,0 +1,67 @@
+// compute_inside_masks: the inside/outside bit of every voxel of every listed brick, by
+// generalized winding numbers (> 1/2 is inside) — correct for closed meshes, robust for holes,
+// open boundaries, self-intersections and (after orient_faces) flipped faces.
+//
+// Inputs: the consistently oriented mesh (orient_faces), its winding tree
+//   (build_winding_tree(oriented_mesh)), brick triangle lists (bin_triangles_to_bricks on the
+//   same triangles, any margin >= 0: every triangle meeting a brick's voxel-centre box must be
+//   listed), options.frame (voxel size h > 0 and origin; half_width is not used), options.beta
+//   (the tree's accuracy parameter) and a progress hook.
+// Output: inside[i] for lists.bricks[i]: bit n set when voxel n (grid/coord.hpp numbering) of
+//   that brick is inside; winding_queries = tree evaluations made (one per brick away from open
+//   edges, more near them); open_edges and direct_bricks (bricks near open edges) for reports.
+// Method: per brick, the integer winding-number jumps along grid edges come from watertight
+//   signed crossings of its listed triangles with the grid lines (grid_crossings.hpp).
+//   - Bricks away from open edges (all bricks of a closed mesh, however self-intersecting or
+//     multiply covered): one tree query at a reference voxel (interior, nearest the brick
+//     centre, as far as possible from crossed edges), then w = w_ref + the jumps along the path
+//     reference -> x -> y -> z (brick_winding.hpp, inside_from_reference). Exact for closed
+//     meshes: path independent, up to the tree's error in w_ref (~1e-2, far below 1/2).
+//   - Bricks within two bricks of an open edge (open_edges.hpp: holes, borders, inconsistent
+//     or non-orientable regions, unmatched fins), where w also varies continuously: adaptive
+//     octree refinement with a trilinear model of the continuous part, checked by direct
+//     queries, down to direct queries next to open edges (inside_adaptive).
+// Points exactly on the surface: classified like the point displaced infinitesimally towards
+//   -x, then -y, then -z (grid_crossings.hpp); e.g. the voxels of an axis-aligned box
+//   [x0, x1] x [y0, y1] x [z0, z1] (grid units) that are inside are x0 < i <= x1,
+//   y0 < j <= y1, z0 < k <= z1.
+// Cost: per brick ~ triangles x (grid lines under their projections) 2D tests plus one tree
+//   query (9 to ~500 near open edges); O(F log F) once for the open edges; memory O(F) for a
+//   grid-space copy of the triangles. Measured (one core, g++ -O3): CGAL bunny00.off (75k
+//   triangles) at 512^3, margin 3h, 20280 bricks: 0.25 s; knot.off at 512^3: 0.17 s.
+// Threading: bricks in parallel (TBB), one brick per task: identical results for any thread
+//   count. Progress: one step per batch of bricks, cancellable (Error{Cancelled}).
+// Errors: Error{InvalidArgument} for a bad frame, lists whose offsets or triangle indices are
+//   inconsistent with the mesh, or a tree built from a mesh with another triangle count;
+//   Error{NonFinite} for non-finite vertices.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "core/progress.hpp"
+#include "distance/brick_triangle_lists.hpp"
+#include "distance/winding_number.hpp"
+#include "grid/brick_mask.hpp"
+#include "grid/narrow_band.hpp"
+#include "io/triangle_mesh.hpp"
+
+namespace levelset {
+
+struct InsideMasksOptions {
+  GridFrame frame;
+  double beta = 2.0;  // winding tree accuracy (see winding_number.hpp)
+  ProgressHook progress;
+};
+
+struct InsideMasksResult {
+  std::vector<BrickMask> inside;       // one per lists.bricks[i]
+  std::uint64_t winding_queries = 0;   // tree evaluations
+  std::uint64_t open_edges = 0;        // edges where the oriented surface is not closed
+  std::uint64_t direct_bricks = 0;     // bricks evaluated voxel by voxel (near open edges)
+};
+
+InsideMasksResult compute_inside_masks(const TriangleMesh& oriented_mesh, const WindingNumberTree& tree,
+                                       const BrickTriangleLists& lists, const InsideMasksOptions& options);
+
+}  // namespace levelset

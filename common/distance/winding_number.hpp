@@ -1,0 +1,66 @@
+// Generalized winding numbers of triangle soups, fast (after Barill, Dickson, Schmidt, Levin,
+// Jacobson, "Fast Winding Numbers for Soups and Clouds", SIGGRAPH 2018).
+//
+// w(p) = (1 / 4 pi) * sum over triangles of the signed solid angle seen from p (solid_angle.hpp).
+// For a closed, outward-oriented mesh w is 1 inside and 0 outside; for open, holed,
+// self-intersecting or multiply-covered meshes it varies smoothly away from the surface and
+// jumps by the local covering number across it, so w > 1/2 is a robust inside test.
+//
+// build_winding_tree
+//   Input: a mesh (world units). Output: a bounding-volume hierarchy over its triangles (median
+//   splits along the longest axis of the centroid box, leaves of at most kLeafTriangles). Every
+//   node stores the area-weighted centroid c of its triangles, the radius of the ball about c
+//   holding all their vertices, and the Taylor coefficients of their solid-angle field about c
+//   up to second order: the area-weighted normal sum N (dipole), the first moment
+//   M = sum a n (x - c)^T and the second moment C = sum a n (x - c)(x - c)^T, both integrated
+//   over the triangles (their own extent included).
+//   Cost: O(F log F) time, ~0.4 KB per leaf plus 72 bytes per triangle. Threading: TBB
+//   (parallel recursion); the tree is identical for any thread count.
+//   Errors: Error{InvalidArgument} for vertex indices out of range, Error{NonFinite} for
+//   non-finite vertices.
+// winding_number(tree, p, beta)
+//   Descends a node only when |p - c| > beta * radius fails, otherwise uses its expansion
+//   (error ~ beta^-3 of the node's solid angle); leaves reached are summed exactly. Measured
+//   worst |w - exact| over random points near and far from CGAL's knot.off and bunny00.off:
+//   beta = 2: 5e-3 (the default: ~3 us per query near 75k triangles), beta = 3: 8e-4,
+//   beta = 4: 3e-4 (~14 us). Cost O(log F) nodes away from the surface, more near it.
+//   Threading: const, safe to call concurrently. Errors: none.
+// winding_number_exact(mesh, p)
+//   The brute-force sum over all triangles (reference for tests), O(F). Indices must be valid.
+#pragma once
+
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+#include "core/vec3.hpp"
+#include "io/triangle_mesh.hpp"
+
+namespace levelset {
+
+struct WindingNumberTree {
+  static constexpr int kLeafTriangles = 8;
+  struct Node {
+    Vec3d center;                  // area-weighted centroid of the node's triangles
+    double radius = 0.0;           // all vertices lie within this distance of center
+    Vec3d normal;                  // sum of area-weighted normals, 1/2 (b - a) x (c - a)
+    std::array<double, 9> first{};   // M[i*3+j] = sum a n_i (x - c)_j        (integrated)
+    std::array<double, 18> second{}; // C[i*6+s] = sum a n_i (x - c)_j (x - c)_k, s = jk in
+                                     // xx, yy, zz, xy, xz, yz               (integrated)
+    std::uint32_t left = 0;        // inner node: children left, right; leaf: triangles
+    std::uint32_t right = 0;       // [left, right) in corners
+    bool leaf = false;
+  };
+  std::vector<Node> nodes;                    // nodes[0] is the root (empty mesh: no nodes)
+  std::vector<std::array<Vec3d, 3>> corners;  // triangle vertices in leaf order
+  std::vector<std::uint32_t> order;           // mesh triangle index of corners[i]
+};
+
+WindingNumberTree build_winding_tree(const TriangleMesh& mesh);
+
+double winding_number(const WindingNumberTree& tree, const Vec3d& p, double beta = 2.0);
+
+double winding_number_exact(const TriangleMesh& mesh, const Vec3d& p);
+
+}  // namespace levelset

@@ -1,0 +1,117 @@
+#!/usr/bin/env bash
+# CLI round trip of the distance subcommands through the real levelsetd binary:
+# cpt (mesh -> band, with closest points) -> info -> sample -> redistance (both methods) -> info,
+# plus their error paths. Args: LEVELSETD SCRATCH_DIR CGAL_DATA_DIR
+set -euo pipefail
+bin=$1; dir=$2; data=$3
+rm -rf "$dir"; mkdir -p "$dir"
+checks=0
+pass() { checks=$((checks + 1)); }
+fail() { echo "cli_distance: FAILED: $*" >&2; exit 1; }
+py=/usr/bin/python3
+
+# A closed box mesh we know the answer for: [0,2]x[0,1]x[0,1].
+cat > "$dir/box.off" <<'MESH'
+OFF
+8 12 0
+0 0 0
+2 0 0
+0 1 0
+2 1 0
+0 0 1
+2 0 1
+0 1 1
+2 1 1
+3 0 2 3
+3 0 3 1
+3 4 5 7
+3 4 7 6
+3 0 1 5
+3 0 5 4
+3 2 6 7
+3 2 7 3
+3 0 4 6
+3 0 6 2
+3 1 3 7
+3 1 7 5
+MESH
+"$bin" cpt "$dir/box.off" --resolution 64 --band 3 --closest-points -o "$dir/box.lsg" \
+  --stats "$dir/cpt.json" > /dev/null || fail "cpt box"
+pass
+"$py" - "$dir/cpt.json" <<'PY' || fail "cpt stats"
+import json, sys
+s = json.load(open(sys.argv[1]))
+assert s["op"] == "cpt" and s["active_voxels"] > 1000 and s["triangles"] == 12, s
+assert all(k in s["seconds"] for k in ("total", "distance", "sign")), s
+assert s["closest_points"] is True
+PY
+pass
+"$bin" info "$dir/box.lsg" --json > "$dir/info.json" || fail "info box.lsg"
+"$py" - "$dir/info.json" "$dir/cpt.json" <<'PY' || fail "info vs stats"
+import json, sys
+i, s = json.load(open(sys.argv[1])), json.load(open(sys.argv[2]))
+assert i["kind"] == "narrow_band" and i["active_voxels"] == s["active_voxels"], (i, s)
+PY
+pass
+
+# Sample at known points: centre (inside, beyond the band), on a face, just outside a face.
+printf '1 0.5 0.5\n0 0.5 0.5\n2.01 0.5 0.5\n100 100 100\n' > "$dir/points.xyz"
+"$bin" sample "$dir/box.lsg" --points "$dir/points.xyz" -o "$dir/values.txt" > /dev/null || fail "sample"
+"$py" - "$dir/values.txt" "$dir/info.json" <<'PY' || fail "sampled values"
+import sys, json
+v = [float(x) for x in open(sys.argv[1]).read().split()]
+bg = json.load(open(sys.argv[2]))["band_half_width"]
+assert len(v) == 4, v
+assert abs(v[0] + bg) < 1e-6, v          # deep inside: -band limit
+assert abs(v[1]) < 1e-6, v               # on the face
+assert abs(v[2] - 0.01) < 1e-4, v        # 0.01 outside the face
+assert abs(v[3] - bg) < 1e-6, v          # far away: +band limit
+PY
+pass
+"$bin" sample "$dir/box.lsg" --points "$dir/points.xyz" | grep -qv nan || fail "sample to stdout"
+pass
+
+for method in sweep march; do
+  "$bin" redistance "$dir/box.lsg" --method "$method" --band 5 -o "$dir/r_$method.lsg" \
+    --stats "$dir/r_$method.json" > /dev/null || fail "redistance $method"
+  "$py" - "$dir/r_$method.json" <<'PY' || fail "redistance stats"
+import json, sys
+s = json.load(open(sys.argv[1]))
+assert s["op"] == "redistance" and s["band_half_width"] == 5 and s["active_voxels"] > 0, s
+PY
+  pass
+done
+
+if [ -f "$data/meshes/knot.off" ]; then
+  "$bin" cpt "$data/meshes/knot.off" --resolution 96 --band 3 -o "$dir/knot.lsg" --threads 1 > /dev/null \
+    || fail "cpt knot.off"
+  "$bin" cpt "$data/meshes/knot.off" --resolution 96 --band 3 -o "$dir/knot2.lsg" --threads 2 > /dev/null \
+    || fail "cpt knot.off 2 threads"
+  cmp -s "$dir/knot.lsg" "$dir/knot2.lsg" || fail "1 and 2 threads give different files"
+  pass
+fi
+
+# Error paths: one line 'levelsetd: ...' on stderr, non-zero exit, no signal.
+expect_error() {
+  local what=$1 pattern=$2; shift 2
+  set +e
+  "$@" > /dev/null 2> "$dir/err.txt"
+  local rc=$?
+  set -e
+  [ "$rc" -ne 0 ] && [ "$rc" -lt 128 ] || fail "$what: exit code $rc"
+  grep -q "^levelsetd: .*$pattern" "$dir/err.txt" || fail "$what: stderr was: $(cat "$dir/err.txt")"
+  pass
+}
+printf 'OFF\n3 1 0\n0 0 0\n1 0 0\nnan 1 0\n3 0 1 2\n' > "$dir/nan.off"
+expect_error "NaN vertex" "non_finite" "$bin" cpt "$dir/nan.off" -r 32 -o "$dir/x.lsg"
+printf 'OFF\n0 0 0\n' > "$dir/empty.off"
+expect_error "empty mesh" "no" "$bin" cpt "$dir/empty.off" -r 32 -o "$dir/x.lsg"
+expect_error "voxel budget" "voxel budget" "$bin" cpt "$dir/box.off" --voxel-size 1e-7 -o "$dir/x.lsg"
+expect_error "both resolution and voxel size" "usage" "$bin" cpt "$dir/box.off" -r 32 --voxel-size 0.1 -o "$dir/x.lsg"
+expect_error "bad method" "usage" "$bin" redistance "$dir/box.lsg" --method magic -o "$dir/x.lsg"
+printf '1 2\n' > "$dir/bad.xyz"
+expect_error "bad points" "parse_error" "$bin" sample "$dir/box.lsg" --points "$dir/bad.xyz"
+[ ! -e "$dir/x.lsg" ] || fail "a failed command left an output file"
+pass
+
+echo "cli_distance: $checks checks passed"

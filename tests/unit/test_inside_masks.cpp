@@ -1,0 +1,270 @@
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdlib>
+#include <memory>
+#include <random>
+
+#include <tbb/task_arena.h>
+
+#include "core/error.hpp"
+#include "distance/brick_triangle_lists.hpp"
+#include "distance/inside_masks.hpp"
+#include "distance/orient_faces.hpp"
+#include "distance/winding_number.hpp"
+#include "distance_test_meshes.hpp"
+
+namespace levelset {
+namespace {
+
+struct Masks {
+  BrickTriangleLists lists;
+  InsideMasksResult result;
+  GridFrame frame;
+
+  // f(world position, grid coordinates, inside bit) for every voxel of every brick.
+  template <typename F>
+  void for_each_voxel(F&& f) const {
+    for (std::size_t i = 0; i < lists.bricks.size(); ++i) {
+      const Coord o = brick_origin(lists.bricks[i]);
+      for (int n = 0; n < kBrickVoxels; ++n) {
+        const Coord g = o + local_coord(n);
+        const Vec3d p = frame.origin + Vec3d{double(g.x), double(g.y), double(g.z)} * frame.voxel_size;
+        f(p, g, result.inside[i].test(n));
+      }
+    }
+  }
+};
+
+Masks compute(const TriangleMesh& oriented, double h, Vec3d origin, double margin_voxels = 3.0) {
+  Masks m;
+  m.frame.voxel_size = h;
+  m.frame.origin = origin;
+  BinTrianglesOptions bin;
+  bin.frame = m.frame;
+  bin.margin = margin_voxels * h;
+  m.lists = bin_triangles_to_bricks(oriented, bin);
+  const WindingNumberTree tree = build_winding_tree(oriented);
+  InsideMasksOptions options;
+  options.frame = m.frame;
+  m.result = compute_inside_masks(oriented, tree, m.lists, options);
+  EXPECT_EQ(m.result.inside.size(), m.lists.bricks.size());
+  // One query per brick, 512 (minus voxels on the surface) per brick near open edges.
+  EXPECT_GE(m.result.winding_queries, m.lists.bricks.size());
+  EXPECT_LE(m.result.winding_queries, m.lists.bricks.size() + 511 * m.result.direct_bricks);
+  if (m.result.open_edges == 0) {
+    EXPECT_EQ(m.result.direct_bricks, 0u);
+  }
+  return m;
+}
+
+// Maps a mesh given in grid coordinates to world coordinates (exactly, for dyadic h and origin).
+TriangleMesh to_world(TriangleMesh m, double h, Vec3d origin) {
+  for (auto& v : m.vertices) v = origin + v * h;
+  return m;
+}
+
+TEST(InsideMasks, IcosphereMatchesThePointInPolyhedronOnEveryVoxel) {
+  const Vec3d centre{0.0137, -0.0291, 0.0419};
+  const TriangleMesh sphere = test::icosphere(4, 1.2, centre);  // 5120 faces, radius 12 voxels
+  ASSERT_EQ(sphere.triangles.size(), 5120u);
+  const Masks m = compute(sphere, 0.1, {0.0, 0.0, 0.0});
+  ASSERT_GT(m.lists.bricks.size(), 50u);
+  const WindingNumberTree tree = build_winding_tree(sphere);
+  std::mt19937 rng(1);
+  std::size_t checked = 0, exact_checked = 0, inside = 0;
+  m.for_each_voxel([&](const Vec3d& p, const Coord&, bool bit) {
+    const double w = winding_number(tree, p);
+    ASSERT_LT(std::abs(w - std::round(w)), 0.01) << "reference ambiguous";
+    ASSERT_EQ(bit, w > 0.5) << p.x << " " << p.y << " " << p.z;
+    if (rng() % 64 == 0) {
+      ASSERT_EQ(bit, winding_number_exact(sphere, p) > 0.5);
+      ++exact_checked;
+    }
+    ++checked;
+    inside += bit;
+  });
+  EXPECT_GT(inside, checked / 10);
+  EXPECT_LT(inside, checked * 9 / 10);
+  EXPECT_GT(exact_checked, 300u);
+}
+
+TEST(InsideMasks, KnotMatchesRayParityOnRandomVoxels) {
+  const TriangleMesh knot = orient_faces(test::load_cgal_mesh("knot.off"), {}).mesh;
+  const BBox box = knot.bounds();
+  const double h = box.longest_side() / 128.0;
+  const Masks m = compute(knot, h, box.min - Vec3d{0.37 * h, 0.71 * h, 0.13 * h});
+  const Vec3d dir = Vec3d{0.5377, 0.8243, 0.1791} / length(Vec3d{0.5377, 0.8243, 0.1791});
+  std::mt19937 rng(2);
+  int checked = 0, inside = 0;
+  m.for_each_voxel([&](const Vec3d& p, const Coord&, bool bit) {
+    if (rng() % 200 != 0) return;
+    ASSERT_EQ(bit, test::ray_parity_inside(knot, p, dir)) << p.x << " " << p.y << " " << p.z;
+    ++checked;
+    inside += bit;
+  });
+  EXPECT_GT(checked, 2000);
+  EXPECT_GT(inside, checked / 20);
+}
+
+// Grid-aligned adversarial input: faces on voxel-centre planes, edges and vertices on grid
+// lines. Points on the surface follow the documented convention: inside iff the point moved
+// infinitesimally by -x (then -y, then -z) is inside.
+TEST(InsideMasks, GridAlignedBoxHasNoSpecklesAndFollowsTheSurfaceConvention) {
+  const double h = 0.5;
+  const Vec3d origin{-2.0, -1.5, -3.0};
+  const std::array<int, 3> lo{3, 8, -2}, hi{23, 14, 30};
+  for (int step : {1, 3}) {
+    const TriangleMesh box = to_world(test::grid_box(lo, hi, step), h, origin);
+    const Masks m = compute(box, h, origin);
+    std::size_t on_surface = 0;
+    m.for_each_voxel([&](const Vec3d&, const Coord& g, bool bit) {
+      bool expected = true;
+      for (int a = 0; a < 3; ++a) expected = expected && lo[a] < g[a] && g[a] <= hi[a];
+      ASSERT_EQ(bit, expected) << "step " << step << " voxel " << g.x << " " << g.y << " " << g.z;
+      bool on = false;
+      for (int a = 0; a < 3; ++a) on = on || g[a] == lo[a] || g[a] == hi[a];
+      on_surface += on;
+    });
+    EXPECT_GT(on_surface, 1000u);
+  }
+}
+
+TEST(InsideMasks, GridAlignedOctahedronFollowsTheSymbolicPerturbation) {
+  const double h = 0.25;
+  const Vec3d origin{1.0, -2.0, 0.5};
+  const std::array<int, 3> c{12, 9, 10};
+  const int r = 10;
+  const TriangleMesh oct = to_world(test::grid_octahedron(c, r), h, origin);
+  const Masks m = compute(oct, h, origin);
+  std::size_t on_surface = 0;
+  m.for_each_voxel([&](const Vec3d&, const Coord& g, bool bit) {
+    // The perturbation p - (e1, e2, e3), e1 >> e2 >> e3, emulated with 1e-3, 1e-6, 1e-9 (exact
+    // enough for unit normals and integer positions).
+    const double x = g.x - c[0] - 1e-3, y = g.y - c[1] - 1e-6, z = g.z - c[2] - 1e-9;
+    const bool expected = std::abs(x) + std::abs(y) + std::abs(z) < r;
+    ASSERT_EQ(bit, expected) << g.x << " " << g.y << " " << g.z;
+    on_surface += std::abs(g.x - c[0]) + std::abs(g.y - c[1]) + std::abs(g.z - c[2]) == r;
+  });
+  EXPECT_EQ(on_surface, 4u * r * r + 2u);  // lattice points on the surface
+}
+
+TEST(InsideMasks, OverlappingSpheresSoupIsTheirUnion) {
+  // Two closed spheres as one self-intersecting soup: winding number 2 where they overlap.
+  const Vec3d ca{0.02, 0.01, -0.03}, cb{0.83, 0.21, 0.07};
+  TriangleMesh soup = test::icosphere(3, 1.0, ca);
+  const TriangleMesh b = test::icosphere(3, 0.8, cb);
+  const std::uint32_t off = std::uint32_t(soup.vertices.size());
+  soup.vertices.insert(soup.vertices.end(), b.vertices.begin(), b.vertices.end());
+  for (auto f : b.triangles) soup.triangles.push_back({f[0] + off, f[1] + off, f[2] + off});
+  const TriangleMesh a = test::icosphere(3, 1.0, ca);
+  const WindingNumberTree ta = build_winding_tree(a), tb = build_winding_tree(b);
+  const Masks m = compute(soup, 0.08, {0, 0, 0});
+  std::size_t twice = 0;
+  m.for_each_voxel([&](const Vec3d& p, const Coord&, bool bit) {
+    const bool in_a = winding_number(ta, p) > 0.5, in_b = winding_number(tb, p) > 0.5;
+    ASSERT_EQ(bit, in_a || in_b);
+    twice += in_a && in_b;
+  });
+  EXPECT_GT(twice, 100u);
+}
+
+TEST(InsideMasks, FlippedFacesAfterOrientationGiveIdenticalMasks) {
+  for (const char* name : {"knot.off", "blobby.off"}) {
+    const TriangleMesh original = test::load_cgal_mesh(name);
+    TriangleMesh scrambled = original;
+    test::flip_random_half(scrambled, 17);
+    const BBox box = original.bounds();
+    const double h = box.longest_side() / 80.0;
+    const Masks a = compute(orient_faces(original, {}).mesh, h, box.min);
+    const Masks b = compute(orient_faces(scrambled, {}).mesh, h, box.min);
+    ASSERT_EQ(a.lists.bricks, b.lists.bricks) << name;
+    ASSERT_EQ(a.result.inside, b.result.inside) << name;
+    std::size_t inside = 0;
+    for (const auto& mask : a.result.inside) inside += std::size_t(mask.count());
+    EXPECT_GT(inside, 1000u) << name;
+  }
+}
+
+TEST(InsideMasks, ElephantWithHolesIsInsideDeepInAndOutsideFarOut) {
+  // 1353 open edges: every brick lies near a hole and is evaluated voxel by voxel.
+  const TriangleMesh holes = orient_faces(test::load_cgal_mesh("elephant-with-holes.off"), {}).mesh;
+  const TriangleMesh closed = orient_faces(test::load_cgal_mesh("elephant.off"), {}).mesh;
+  const BBox box = closed.bounds();
+  const double h = box.longest_side() / 64.0;
+  const Masks m = compute(holes, h, box.min);
+  EXPECT_EQ(m.result.open_edges, 1353u);
+  EXPECT_GT(m.result.direct_bricks, 0u);
+  const WindingNumberTree closed_tree = build_winding_tree(closed);
+  const WindingNumberTree holes_tree = build_winding_tree(holes);
+  std::size_t deep = 0, far = 0, agree = 0, total = 0, wrong = 0;
+  m.for_each_voxel([&](const Vec3d& p, const Coord&, bool bit) {
+    const double wc = winding_number(closed_tree, p);
+    const double wh = winding_number(holes_tree, p);
+    // Where the holed surface's own winding number is unambiguous it decides.
+    if (wh > 0.6) {
+      wrong += !bit;
+      deep += wc > 0.5;
+    }
+    if (wh < 0.4) {
+      wrong += bit;
+      far += wc < 0.5;
+    }
+    ++total;
+    agree += bit == (wc > 0.5);
+  });
+  EXPECT_EQ(wrong, 0u);
+  EXPECT_GT(deep, 1000u);
+  EXPECT_GT(far, 10000u);
+  // And it is mostly the closed elephant's inside.
+  EXPECT_GT(double(agree), 0.95 * double(total));
+}
+
+TEST(InsideMasks, DeterministicForAnyThreadCount) {
+  const TriangleMesh knot = orient_faces(test::load_cgal_mesh("knot.off"), {}).mesh;
+  const BBox box = knot.bounds();
+  const double h = box.longest_side() / 100.0;
+  Masks one, two;
+  tbb::task_arena(1).execute([&] { one = compute(knot, h, box.min); });
+  tbb::task_arena(2).execute([&] { two = compute(knot, h, box.min); });
+  EXPECT_EQ(one.result.inside, two.result.inside);
+}
+
+TEST(InsideMasks, CancelsAndRejectsInconsistentInput) {
+  const TriangleMesh sphere = test::icosphere(3);
+  GridFrame frame;
+  frame.voxel_size = 0.05;
+  BinTrianglesOptions bin;
+  bin.frame = frame;
+  bin.margin = 0.15;
+  const BrickTriangleLists lists = bin_triangles_to_bricks(sphere, bin);
+  const WindingNumberTree tree = build_winding_tree(sphere);
+  InsideMasksOptions options;
+  options.frame = frame;
+  auto token = std::make_shared<CancelToken>();
+  token->cancel();
+  options.progress.cancel = token;
+  auto expect_code = [&](auto&& call, ErrorCode code) {
+    try {
+      call();
+      ADD_FAILURE() << "expected an error";
+    } catch (const Error& e) {
+      EXPECT_EQ(e.code(), code) << e.what();
+    }
+  };
+  expect_code([&] { (void)compute_inside_masks(sphere, tree, lists, options); }, ErrorCode::Cancelled);
+  options.progress = {};
+  const WindingNumberTree other = build_winding_tree(test::icosphere(1));
+  expect_code([&] { (void)compute_inside_masks(sphere, other, lists, options); }, ErrorCode::InvalidArgument);
+  BrickTriangleLists broken = lists;
+  broken.triangles[0] = 1u << 30;
+  expect_code([&] { (void)compute_inside_masks(sphere, tree, broken, options); }, ErrorCode::InvalidArgument);
+  options.frame.voxel_size = 0.0;
+  expect_code([&] { (void)compute_inside_masks(sphere, tree, lists, options); }, ErrorCode::InvalidArgument);
+  // No bricks: no masks.
+  options.frame.voxel_size = 0.05;
+  EXPECT_TRUE(compute_inside_masks(sphere, tree, BrickTriangleLists{}, options).inside.empty());
+}
+
+}  // namespace
+}  // namespace levelset

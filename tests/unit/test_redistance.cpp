@@ -1,0 +1,485 @@
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <memory>
+#include <string>
+
+#include <tbb/task_arena.h>
+
+#include "core/error.hpp"
+#include "distance/redistance.hpp"
+#include "grid/band_accessor.hpp"
+#include "grid/band_builder.hpp"
+#include "shape_band.hpp"
+
+namespace levelset {
+namespace {
+
+using test::make_shape_band;
+
+// A smooth positive factor in [0.5, 1.5]: u*wobble keeps the zero level and the signs but
+// destroys |grad u| = 1.
+double wobble(const Vec3d& p) { return 1.0 + 0.5 * std::sin(3 * p.x) * std::sin(3 * p.y) * std::sin(3 * p.z); }
+
+NarrowBand distort(const NarrowBand& band) {
+  NarrowBand out = band;
+  for (std::uint32_t b = 0; b < out.brick_count(); ++b) {
+    const Coord o = brick_origin(out.bricks()[b].coord);
+    out.update_active_in_brick(b, [&](int n, float v) { return float(double(v) * wobble(out.world(o + local_coord(n)))); });
+  }
+  return out;
+}
+
+RedistanceResult run(const NarrowBand& in, RedistanceMethod method, double half_width = 0.0) {
+  RedistanceOptions o;
+  o.method = method;
+  o.half_width = half_width;
+  return redistance(in, o);
+}
+
+const char* name(RedistanceMethod m) { return m == RedistanceMethod::Sweep ? "sweep" : "march"; }
+
+struct Quality {
+  double value_error = 0;           // max |d - exact| / h over the output's active voxels
+  double grad_error = 0;            // max ||grad d| - 1|, |d| >= 1.5h, full stencil in the band
+  double grad_error_interface = 0;  // the same at voxels next to the zero level
+  double exact_grad_error = 0;      // the exact SDF's own central-difference error there
+  double crossing_shift = 0;        // max edge-crossing displacement / h
+  std::size_t grad_samples = 0, crossings = 0;
+};
+
+Quality measure(const NarrowBand& in, const NarrowBand& out, const AnalyticShape& shape) {
+  Quality q;
+  const double h = out.voxel_size();
+  BandAccessor acc(out), acc_in(in);
+  static constexpr Coord kAxis[3] = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
+  out.for_each_active([&](const Coord& c, float v) {
+    q.value_error = std::max(q.value_error, std::abs(v - shape.distance(out.world(c))) / h);
+    double g2 = 0, e2 = 0;
+    bool full = true, interface = false;
+    for (int a = 0; a < 3; ++a) {
+      const auto p = acc.probe(c + kAxis[a]), m = acc.probe(c - kAxis[a]);
+      if (!p || !m) { full = false; break; }
+      interface |= (*p < 0) != (v < 0) || (*m < 0) != (v < 0);
+      const double g = (double(*p) - double(*m)) / (2 * h);
+      const double e = (shape.distance(out.world(c + kAxis[a])) - shape.distance(out.world(c - kAxis[a]))) / (2 * h);
+      g2 += g * g;
+      e2 += e * e;
+    }
+    if (!full) return;
+    const double err = std::abs(std::sqrt(g2) - 1.0);
+    if (interface) q.grad_error_interface = std::max(q.grad_error_interface, err);
+    if (std::abs(v) < 1.5 * h) return;
+    q.grad_error = std::max(q.grad_error, err);
+    q.exact_grad_error = std::max(q.exact_grad_error, std::abs(std::sqrt(e2) - 1.0));
+    ++q.grad_samples;
+  });
+  // Zero crossings along every edge with a sign change, before and after.
+  in.for_each_active([&](const Coord& c, float u) {
+    for (int a = 0; a < 3; ++a) {
+      const Coord e = c + kAxis[a];
+      const auto ue = acc_in.probe(e);
+      if (!ue || (*ue < 0) == (u < 0)) continue;
+      const auto dc = acc.probe(c), de = acc.probe(e);
+      ASSERT_TRUE(dc && de) << "sign-change edge left the band";
+      ASSERT_EQ(*dc < 0, u < 0);
+      ASSERT_EQ(*de < 0, *ue < 0);
+      const double before = double(u) / (double(u) - double(*ue));
+      const double after = double(*dc) / (double(*dc) - double(*de));
+      q.crossing_shift = std::max(q.crossing_shift, std::abs(after - before));
+      ++q.crossings;
+    }
+  });
+  return q;
+}
+
+void print(const std::string& what, RedistanceMethod m, const Quality& q, const RedistanceResult& r) {
+  std::printf("[%s %s] voxels %zu, interface %llu, iterations %d, %.3f s | value err %.4f h | "
+              "|grad|-1: %.4f (exact SDF %.4f, %zu samples), at interface %.4f | crossing shift %.4f h (%zu edges)\n",
+              what.c_str(), name(m), r.band.active_voxel_count(), (unsigned long long)r.interface_voxels,
+              r.sweep_iterations, r.seconds, q.value_error, q.grad_error, q.exact_grad_error, q.grad_samples,
+              q.grad_error_interface, q.crossing_shift, q.crossings);
+}
+
+// Signs against the exact shape and the band invariant, in a box around the band.
+void expect_signs_and_invariant(const NarrowBand& out, const AnalyticShape& shape, int margin) {
+  IndexBox box = out.active_index_bounds();
+  ASSERT_FALSE(box.empty());
+  BandAccessor acc(out);
+  std::size_t wrong_sign = 0, broken = 0;
+  for (int z = box.min.z - margin; z <= box.max.z + margin; ++z)
+    for (int y = box.min.y - margin; y <= box.max.y + margin; ++y)
+      for (int x = box.min.x - margin; x <= box.max.x + margin; ++x) {
+        const Coord c{x, y, z};
+        const bool inside = acc.is_inside(c);
+        wrong_sign += inside != (float(shape.distance(out.world(c))) < 0.0f);
+        for (const Coord d : {Coord{1, 0, 0}, Coord{0, 1, 0}, Coord{0, 0, 1}}) {
+          if (acc.is_inside(c + d) != inside) broken += !acc.is_active(c) || !acc.is_active(c + d);
+        }
+      }
+  EXPECT_EQ(wrong_sign, 0u);
+  EXPECT_EQ(broken, 0u);
+}
+
+class RedistanceShapes : public ::testing::TestWithParam<RedistanceMethod> {};
+
+TEST_P(RedistanceShapes, DistortedSphere) {
+  const auto sb = make_shape_band("sphere", 128);
+  const NarrowBand in = distort(sb.band);
+  const RedistanceResult r = run(in, GetParam());
+  const Quality q = measure(in, r.band, *sb.shape);
+  print("sphere R=128", GetParam(), q, r);
+  EXPECT_GT(q.grad_samples, 10000u);
+  EXPECT_LT(q.value_error, 0.05);
+  EXPECT_LT(q.grad_error, 1e-2);
+  EXPECT_LT(q.crossing_shift, 0.05);
+  expect_signs_and_invariant(r.band, *sb.shape, 6);
+}
+
+TEST_P(RedistanceShapes, DistortedTorus) {
+  const auto sb = make_shape_band("torus", 192);
+  const NarrowBand in = distort(sb.band);
+  const RedistanceResult r = run(in, GetParam());
+  const Quality q = measure(in, r.band, *sb.shape);
+  print("torus R=192", GetParam(), q, r);
+  EXPECT_LT(q.value_error, 0.05);
+  EXPECT_LT(q.grad_error, 1e-2);
+  EXPECT_LT(q.crossing_shift, 0.05);
+  expect_signs_and_invariant(r.band, *sb.shape, 4);
+}
+
+TEST_P(RedistanceShapes, DistortedKnot) {
+  const auto sb = make_shape_band("knot", 256);
+  const NarrowBand in = distort(sb.band);
+  const RedistanceResult r = run(in, GetParam());
+  const Quality q = measure(in, r.band, *sb.shape);
+  print("knot R=256", GetParam(), q, r);
+  EXPECT_LT(q.value_error, 0.05);
+  EXPECT_LT(q.grad_error, 1e-2);
+  EXPECT_LT(q.crossing_shift, 0.05);
+  expect_signs_and_invariant(r.band, *sb.shape, 2);
+}
+
+INSTANTIATE_TEST_SUITE_P(Redistance, RedistanceShapes,
+                         ::testing::Values(RedistanceMethod::Sweep, RedistanceMethod::March),
+                         [](const auto& info) { return std::string(name(info.param)); });
+
+// Largest |a - b| / h over voxels active in both; counts voxels active in only one, and the
+// smallest |value| / h among those.
+struct BandDiff {
+  double max_diff = 0;
+  std::size_t common = 0, only_one = 0;
+  double min_only_one = 1e30;
+};
+BandDiff compare(const NarrowBand& a, const NarrowBand& b) {
+  BandDiff d;
+  const double h = a.voxel_size();
+  BandAccessor acc_a(a), acc_b(b);
+  a.for_each_active([&](const Coord& c, float v) {
+    const auto w = acc_b.probe(c);
+    if (!w) {
+      ++d.only_one;
+      d.min_only_one = std::min(d.min_only_one, std::abs(double(v)) / h);
+      return;
+    }
+    ++d.common;
+    d.max_diff = std::max(d.max_diff, std::abs(double(v) - double(*w)) / h);
+  });
+  b.for_each_active([&](const Coord& c, float v) {
+    if (acc_a.is_active(c)) return;
+    ++d.only_one;
+    d.min_only_one = std::min(d.min_only_one, std::abs(double(v)) / h);
+  });
+  return d;
+}
+
+TEST_P(RedistanceShapes, GrowingMatchesBuildingWide) {
+  // Same frame for both: frame_for_resolution depends on W, so build the W=5 band and the
+  // W=2 band on the W=5 frame.
+  const auto wide = make_shape_band("torus", 128, 5.0);
+  SdfBuildOptions narrow_options;
+  narrow_options.frame = wide.band.frame();
+  narrow_options.frame.half_width = 2.0;
+  const AnalyticShape* shape = wide.shape.get();
+  const NarrowBand narrow =
+      build_from_sdf([shape](const Vec3d& p) { return shape->distance(p); }, shape->bounds(), narrow_options).band;
+  const RedistanceResult direct = run(distort(wide.band), GetParam());
+  const RedistanceResult grown = run(distort(narrow), GetParam(), 5.0);
+  EXPECT_EQ(grown.band.half_width(), 5.0);
+  EXPECT_EQ(grown.interface_voxels, direct.interface_voxels);
+  const BandDiff d = compare(direct.band, grown.band);
+  std::printf("[grow 2->5 %s] common %zu, max diff %.2e h, only in one %zu (|d| >= %.3f h)\n", name(GetParam()),
+              d.common, d.max_diff, d.only_one, d.min_only_one);
+  EXPECT_GT(d.common, direct.band.active_voxel_count() * 99 / 100);
+  // Interface voxels whose 3x3x3 stencil leaves the W=2 band fall back to the crossing
+  // plane (first order in the curvature), so values differ by that error at most.
+  EXPECT_LT(d.max_diff, 0.05);
+  EXPECT_GT(d.min_only_one, 4.8);  // only voxels at the band's edge may be in one only
+  const Quality q = measure(distort(narrow), grown.band, *shape);
+  EXPECT_LT(q.value_error, 0.05);
+  EXPECT_LT(q.grad_error, 1e-2);
+  expect_signs_and_invariant(grown.band, *shape, 3);
+}
+
+TEST_P(RedistanceShapes, ShrinkingKeepsTheInnerBand) {
+  const auto wide = make_shape_band("knot", 128, 5.0);
+  const NarrowBand in = distort(wide.band);
+  const RedistanceResult full = run(in, GetParam());
+  const RedistanceResult shrunk = run(in, GetParam(), 2.0);
+  EXPECT_EQ(shrunk.band.half_width(), 2.0);
+  EXPECT_FLOAT_EQ(shrunk.band.background(), float(2.0 * in.voxel_size()));
+  const double h = in.voxel_size();
+  // The shrunk band is the full result restricted to |d| <= 2h.
+  std::size_t expected = 0;
+  BandAccessor acc(shrunk.band);
+  double max_diff = 0;
+  full.band.for_each_active([&](const Coord& c, float v) {
+    const auto w = acc.probe(c);
+    if (std::abs(double(v)) <= 2.0 * h) {
+      ++expected;
+      ASSERT_TRUE(w.has_value());
+      max_diff = std::max(max_diff, std::abs(double(*w) - double(v)) / h);
+    } else {
+      EXPECT_FALSE(w.has_value());
+    }
+  });
+  EXPECT_EQ(shrunk.band.active_voxel_count(), expected);
+  // Sweep solves the same domain and truncates (identical); March stops early, where the
+  // second-order stencils may miss a value beyond the cut.
+  EXPECT_LT(max_diff, GetParam() == RedistanceMethod::Sweep ? 1e-7 : 1e-3);
+  EXPECT_LT(shrunk.band.brick_count(), full.band.brick_count());
+  expect_signs_and_invariant(shrunk.band, *wide.shape, 3);
+}
+
+TEST_P(RedistanceShapes, BitIdenticalForAnyThreadCount) {
+  const auto sb = make_shape_band("knot", 96);
+  const NarrowBand in = distort(sb.band);
+  RedistanceResult one, two;
+  tbb::task_arena(1).execute([&] { one = run(in, GetParam(), 4.0); });
+  tbb::task_arena(2).execute([&] { two = run(in, GetParam(), 4.0); });
+  EXPECT_TRUE(one.band.identical(two.band));
+  EXPECT_EQ(one.sweep_iterations, two.sweep_iterations);
+  EXPECT_EQ(one.interface_voxels, two.interface_voxels);
+}
+
+TEST_P(RedistanceShapes, ExactDistanceIsNearlyAFixedPoint) {
+  const auto sb = make_shape_band("torus", 128);
+  const RedistanceResult r = run(sb.band, GetParam());
+  const BandDiff d = compare(sb.band, r.band);
+  const RedistanceResult again = run(r.band, GetParam());
+  const BandDiff d2 = compare(r.band, again.band);
+  std::printf("[fixed point %s] exact input: max change %.4f h; second pass: max change %.4f h\n", name(GetParam()),
+              d.max_diff, d2.max_diff);
+  EXPECT_LT(d.max_diff, 0.02);
+  EXPECT_GT(d.min_only_one, 2.9);
+  EXPECT_LT(d2.max_diff, 0.01);
+}
+
+TEST_P(RedistanceShapes, FirstOrderIsCoarserButConsistent) {
+  const auto sb = make_shape_band("sphere", 128);
+  const NarrowBand in = distort(sb.band);
+  RedistanceOptions o;
+  o.method = GetParam();
+  o.order = 1;
+  const RedistanceResult r = redistance(in, o);
+  const Quality q = measure(in, r.band, *sb.shape);
+  print("sphere R=128 first order", GetParam(), q, r);
+  EXPECT_LT(q.value_error, 0.05);
+  EXPECT_LT(q.grad_error, 0.02);
+  EXPECT_LT(q.crossing_shift, 0.05);
+}
+
+TEST_P(RedistanceShapes, InsideOutShapeKeepsFarInside) {
+  // The complement of a sphere: values and signs negated, far_inside = true.
+  const auto sb = make_shape_band("sphere", 64);
+  BandBuilder builder(sb.band.frame());
+  for (std::uint32_t b = 0; b < sb.band.brick_count(); ++b) {
+    const Brick& br = sb.band.bricks()[b];
+    BrickMask inside = sb.band.inside_mask(b);
+    for (auto& w : inside.words) w = ~w;
+    float dense[kBrickVoxels] = {};
+    const float* v = sb.band.brick_values(b).data();
+    br.active.for_each_set([&](int n) {
+      dense[n] = -*v++;
+      if (dense[n] == 0.0f) inside.reset(n);  // a zero value reads as outside
+    });
+    builder.add_brick(br.coord, br.active, inside, dense);
+  }
+  const NarrowBand in = distort(builder.finish(true));
+  const RedistanceResult r = run(in, GetParam(), 2.0);
+  EXPECT_TRUE(r.band.far_inside());
+  BandAccessor acc(r.band), acc_in(in);
+  const IndexBox box = in.active_index_bounds();
+  for (int z = box.min.z - 12; z <= box.max.z + 12; ++z)
+    for (int y = box.min.y - 12; y <= box.max.y + 12; ++y)
+      for (int x = box.min.x - 12; x <= box.max.x + 12; ++x)
+        ASSERT_EQ(acc.is_inside({x, y, z}), acc_in.is_inside({x, y, z})) << x << "," << y << "," << z;
+  const Quality q = measure(in, r.band, *make_sphere({0, 0, 0}, 1.0));  // |d| error is sign-blind below
+  EXPECT_LT(q.crossing_shift, 0.05);
+  double worst = 0;
+  r.band.for_each_active([&](const Coord& c, float v) {
+    worst = std::max(worst, std::abs(double(v) + sb.shape->distance(r.band.world(c))) / r.band.voxel_size());
+  });
+  EXPECT_LT(worst, 0.05);
+}
+
+// Sweep and March solve the same discrete equations.
+TEST(RedistanceMethods, SweepAndMarchAgree) {
+  const auto sb = make_shape_band("knot", 128);
+  const NarrowBand in = distort(sb.band);
+  for (int order : {1, 2}) {
+    RedistanceOptions o;
+    o.order = order;
+    o.method = RedistanceMethod::Sweep;
+    const RedistanceResult s = redistance(in, o);
+    o.method = RedistanceMethod::March;
+    const RedistanceResult m = redistance(in, o);
+    const BandDiff d = compare(s.band, m.band);
+    std::printf("[sweep vs march, order %d] common %zu, max diff %.2e h, only in one %zu\n", order, d.common,
+                d.max_diff, d.only_one);
+    EXPECT_LT(d.max_diff, order == 1 ? 1e-5 : 1e-2);
+    EXPECT_LE(d.only_one, s.band.active_voxel_count() / 10000);
+    EXPECT_GE(s.sweep_iterations, 2);
+    EXPECT_EQ(m.sweep_iterations, 0);
+  }
+}
+
+// A brick row with no band left after shrinking keeps a brick that carries its sign when
+// that sign differs from far_inside. With a valid input that cannot happen (far along x every
+// row has the far_inside sign), so this input is a prism infinite along x (cross-section y in
+// [0.5, 30.5], z in [-12.5, 3.5]) stored in bricks x in [0, 32): its faces cross unallocated
+// bricks at the ends. Its deep rows lie more than W = 1 from its faces; the output must
+// still give every voxel the input's sign.
+TEST(RedistanceSigns, RowWithoutBandKeepsItsSign) {
+  auto sdf = [](double y, double z) {  // 2D box distance in (y, z)
+    const double qy = std::abs(y - 15.5) - 15.0, qz = std::abs(z + 4.5) - 8.0;
+    return std::hypot(std::max(qy, 0.0), std::max(qz, 0.0)) + std::min(std::max(qy, qz), 0.0);
+  };
+  const GridFrame frame{1.0, {0, 0, 0}, 10.0};
+  BandBuilder builder(frame);
+  for (int bz = -3; bz <= 0; ++bz)
+    for (int by = -1; by <= 4; ++by)
+      for (int bx = 0; bx < 4; ++bx) {
+        BrickMask active, inside;
+        float dense[kBrickVoxels];
+        for (int n = 0; n < kBrickVoxels; ++n) {
+          const Coord c = brick_origin({bx, by, bz}) + local_coord(n);
+          const double d = sdf(c.y, c.z);
+          dense[n] = float(1.5 * d);
+          if (dense[n] < 0) inside.set(n);
+          if (std::abs(d) <= 10.0) active.set(n);
+        }
+        builder.add_brick({bx, by, bz}, active, inside, dense);
+      }
+  const NarrowBand in = builder.finish(false);
+  for (RedistanceMethod m : {RedistanceMethod::Sweep, RedistanceMethod::March}) {
+    const RedistanceResult r = run(in, m, 1.0);
+    for (int z = -28; z < 12; ++z)
+      for (int y = -12; y < 44; ++y)
+        for (int x = -20; x < 52; ++x)
+          ASSERT_EQ(r.band.is_inside({x, y, z}), in.is_inside({x, y, z})) << name(m) << " " << x << "," << y << "," << z;
+    std::size_t carriers = 0;
+    for (std::uint32_t b = 0; b < r.band.brick_count(); ++b) carriers += r.band.bricks()[b].active.none();
+    EXPECT_GT(carriers, 0u);
+    EXPECT_LT(r.band.brick_count(), in.brick_count());
+    // Away from the prism's edges and ends the distance is a plane's: exact.
+    double worst = 0;
+    r.band.for_each_active([&](const Coord& c, float v) {
+      if (c.x > 2 && c.x < 29 && c.y > 3 && c.y < 28 && c.z > -10) worst = std::max(worst, std::abs(v - sdf(c.y, c.z)));
+    });
+    EXPECT_LT(worst, 1e-5) << name(m);
+  }
+}
+
+TEST(RedistanceErrors, RejectsBadOptions) {
+  const auto sb = make_shape_band("sphere", 32);
+  auto expect_invalid = [&](RedistanceOptions o) {
+    try {
+      redistance(sb.band, o);
+      ADD_FAILURE() << "options accepted";
+    } catch (const Error& e) {
+      EXPECT_EQ(e.code(), ErrorCode::InvalidArgument);
+    }
+  };
+  RedistanceOptions o;
+  o.half_width = 0.5;
+  expect_invalid(o);
+  o.half_width = -3;
+  expect_invalid(o);
+  o.half_width = std::nan("");
+  expect_invalid(o);
+  o.half_width = std::numeric_limits<double>::infinity();
+  expect_invalid(o);
+  o.half_width = 2000;
+  expect_invalid(o);
+  o = {};
+  o.max_sweep_iterations = 0;
+  expect_invalid(o);
+  o = {};
+  o.tolerance = -1;
+  expect_invalid(o);
+  o = {};
+  o.order = 3;
+  expect_invalid(o);
+  o = {};
+  o.half_width = 1.0;
+  EXPECT_NO_THROW(redistance(sb.band, o));
+}
+
+TEST(RedistanceErrors, EmptyBandGivesEmptyBand) {
+  const GridFrame frame{0.25, {1, 2, 3}, 3.0};
+  for (RedistanceMethod m : {RedistanceMethod::Sweep, RedistanceMethod::March}) {
+    NarrowBand empty(frame);
+    empty.set_far_inside(true);
+    RedistanceResult r = run(empty, m);
+    EXPECT_EQ(r.band.brick_count(), 0u);
+    EXPECT_EQ(r.band.voxel_size(), 0.25);
+    EXPECT_TRUE(r.band.origin() == (Vec3d{1, 2, 3}));
+    EXPECT_EQ(r.band.half_width(), 3.0);
+    EXPECT_TRUE(r.band.far_inside());
+    EXPECT_EQ(r.interface_voxels, 0u);
+    r = run(empty, m, 5.0);
+    EXPECT_EQ(r.band.half_width(), 5.0);
+    // Bricks but no zero crossing: nothing to measure from, no active voxel left.
+    NarrowBand positive(frame);
+    for (int i = 0; i < 10; ++i) positive.set_value({i, 0, 0}, 0.1f);
+    r = run(positive, m);
+    EXPECT_EQ(r.band.active_voxel_count(), 0u);
+    EXPECT_EQ(r.interface_voxels, 0u);
+    EXPECT_FALSE(r.band.is_inside({3, 0, 0}));
+  }
+}
+
+TEST(RedistanceErrors, CancellationStopsTheWork) {
+  const auto sb = make_shape_band("sphere", 64);
+  for (RedistanceMethod m : {RedistanceMethod::Sweep, RedistanceMethod::March}) {
+    auto token = std::make_shared<CancelToken>();
+    RedistanceOptions o;
+    o.method = m;
+    o.progress.cancel = token;
+    int calls = 0;
+    double last = -1;
+    o.progress.on_progress = [&](double f, std::string_view) {
+      EXPECT_GE(f, last);
+      last = f;
+      ++calls;
+    };
+    EXPECT_NO_THROW(redistance(sb.band, o));
+    EXPECT_GE(calls, 3);
+    EXPECT_EQ(last, 1.0);
+    // Cancel from inside the operation, after the first report.
+    o.progress.on_progress = [&](double, std::string_view) { token->cancel(); };
+    try {
+      redistance(sb.band, o);
+      ADD_FAILURE() << "not cancelled";
+    } catch (const Error& e) {
+      EXPECT_EQ(e.code(), ErrorCode::Cancelled);
+    }
+  }
+}
+
+}  // namespace
+}  // namespace levelset

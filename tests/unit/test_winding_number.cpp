@@ -1,0 +1,145 @@
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <random>
+
+#include <tbb/task_arena.h>
+
+#include "core/error.hpp"
+#include "distance/winding_number.hpp"
+#include "distance_test_meshes.hpp"
+#include "geometry/point_triangle.hpp"
+
+namespace levelset {
+namespace {
+
+double distance_to_mesh(const TriangleMesh& m, const Vec3d& p) {
+  double best = 1e300;
+  for (const auto& f : m.triangles)
+    best = std::min(best, closest_point_on_triangle(p, m.vertices[f[0]], m.vertices[f[1]], m.vertices[f[2]])
+                              .distance_squared);
+  return std::sqrt(best);
+}
+
+// Random points in the mesh's bounding box grown by 20%, at least `gap` (relative to the box
+// diagonal) from the surface.
+std::vector<Vec3d> sample_points(const TriangleMesh& m, int count, double gap, std::uint32_t seed) {
+  const BBox box = m.bounds();
+  const Vec3d e = box.extent();
+  const double diag = length(e);
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> U(-0.2, 1.2);
+  std::vector<Vec3d> out;
+  while (int(out.size()) < count) {
+    const Vec3d p = box.min + Vec3d{e.x * U(rng), e.y * U(rng), e.z * U(rng)};
+    if (distance_to_mesh(m, p) >= gap * diag) out.push_back(p);
+  }
+  return out;
+}
+
+void expect_closed_mesh_accurate(const TriangleMesh& m, const char* name) {
+  const WindingNumberTree tree = build_winding_tree(m);
+  int inside = 0;
+  double worst2 = 0.0, worst4 = 0.0;
+  for (const Vec3d& p : sample_points(m, 400, 0.01, 3)) {
+    const double exact = winding_number_exact(m, p);
+    // Closed and outward: exactly 0 or 1 up to rounding.
+    ASSERT_LT(std::min(std::abs(exact), std::abs(exact - 1.0)), 1e-9) << name;
+    worst2 = std::max(worst2, std::abs(winding_number(tree, p) - exact));
+    worst4 = std::max(worst4, std::abs(winding_number(tree, p, 4.0) - exact));
+    inside += exact > 0.5;
+  }
+  EXPECT_LT(worst2, 1e-2) << name;  // default beta = 2
+  EXPECT_LT(worst4, 1e-3) << name;
+  EXPECT_GT(inside, 3) << name;
+}
+
+TEST(WindingNumber, ClosedMeshesAreOneInsideZeroOutside) {
+  expect_closed_mesh_accurate(test::icosphere(4, 2.0, {0.3, -0.2, 0.1}), "icosphere");
+  expect_closed_mesh_accurate(test::torus(2.0, 0.7, 60, 24), "torus");
+  expect_closed_mesh_accurate(test::load_cgal_mesh("knot.off"), "knot.off");
+  expect_closed_mesh_accurate(test::load_cgal_mesh("cube.off"), "cube.off");
+}
+
+TEST(WindingNumber, OpenHemisphereIsHalfAtTheCentreOfItsOpening) {
+  const TriangleMesh m = test::hemisphere(24, 48);
+  const WindingNumberTree tree = build_winding_tree(m);
+  // The full hemisphere subtends 2 pi from its centre; the mesh's inscribed polygon a bit less.
+  EXPECT_NEAR(winding_number(tree, {0, 0, 0}), 0.5, 5e-3);
+  EXPECT_NEAR(winding_number_exact(m, {0, 0, 0}), 0.5, 5e-3);
+  // Inside the dome: between 1/2 and 1; below the opening: between 0 and 1/2; far away: ~0.
+  const double dome = winding_number(tree, {0, 0, 0.5});
+  EXPECT_GT(dome, 0.5);
+  EXPECT_LT(dome, 1.0);
+  const double below = winding_number(tree, {0, 0, -0.5});
+  EXPECT_GT(below, 0.0);
+  EXPECT_LT(below, 0.5);
+  EXPECT_NEAR(dome + below, 1.0, 0.02);  // solid angles of the dome seen from +-z sum to ~4 pi
+  EXPECT_NEAR(winding_number(tree, {0, 0, 50}), 0.0, 1e-3);
+  for (const Vec3d& p : {Vec3d{0.1, 0.2, 0.3}, Vec3d{0.3, -0.5, -0.2}, Vec3d{2, 1, 0.5}}) {
+    EXPECT_NEAR(winding_number(tree, p), winding_number_exact(m, p), 1e-2);
+    EXPECT_NEAR(winding_number(tree, p, 4.0), winding_number_exact(m, p), 1e-3);
+  }
+}
+
+TEST(WindingNumber, ErrorShrinksWithBeta) {
+  const TriangleMesh m = test::load_cgal_mesh("knot.off");
+  const WindingNumberTree tree = build_winding_tree(m);
+  std::mt19937_64 rng(9);
+  const BBox box = m.bounds();
+  std::uniform_real_distribution<double> U(0.0, 1.0);
+  double worst[3] = {0, 0, 0};
+  const double betas[3] = {1.0, 2.0, 4.0};
+  for (int i = 0; i < 300; ++i) {
+    // Anywhere in the box, close to the surface or not.
+    const Vec3d p = box.min + Vec3d{box.extent().x * U(rng), box.extent().y * U(rng), box.extent().z * U(rng)};
+    const double exact = winding_number_exact(m, p);
+    for (int b = 0; b < 3; ++b) worst[b] = std::max(worst[b], std::abs(winding_number(tree, p, betas[b]) - exact));
+  }
+  EXPECT_LT(worst[2], worst[1]);
+  EXPECT_LT(worst[1], worst[0]);
+  EXPECT_LT(worst[1], 1e-2);
+  EXPECT_LT(worst[2], 5e-4);
+  // beta so large that every leaf is summed exactly: the brute-force value up to rounding.
+  const Vec3d p = box.center();
+  EXPECT_NEAR(winding_number(tree, p, 1e9), winding_number_exact(m, p), 1e-12);
+}
+
+TEST(WindingNumber, SoupsFlippedFacesAndEmptyMesh) {
+  // Flipping faces changes the exact value; the tree follows the exact value.
+  TriangleMesh m = test::icosphere(3);
+  test::flip_random_half(m, 4);
+  const WindingNumberTree tree = build_winding_tree(m);
+  for (const Vec3d& p : {Vec3d{0, 0, 0}, Vec3d{0.5, 0.1, 0}, Vec3d{3, 0, 0}})
+    EXPECT_NEAR(winding_number(tree, p, 4.0), winding_number_exact(m, p), 1e-3);
+  EXPECT_EQ(winding_number(build_winding_tree(TriangleMesh{}), {0, 0, 0}), 0.0);
+  // Tree identical for any thread count.
+  const TriangleMesh big = test::icosphere(5);
+  WindingNumberTree one, two;
+  tbb::task_arena(1).execute([&] { one = build_winding_tree(big); });
+  tbb::task_arena(2).execute([&] { two = build_winding_tree(big); });
+  ASSERT_EQ(one.nodes.size(), two.nodes.size());
+  EXPECT_EQ(one.order, two.order);
+  for (std::size_t i = 0; i < one.nodes.size(); ++i) {
+    EXPECT_EQ(one.nodes[i].center, two.nodes[i].center);
+    EXPECT_EQ(one.nodes[i].second, two.nodes[i].second);
+  }
+}
+
+TEST(WindingNumber, BuildRejectsBadInput) {
+  TriangleMesh m = test::icosphere(1);
+  m.triangles.push_back({0, 1, 9999});
+  EXPECT_THROW((void)build_winding_tree(m), Error);
+  m.triangles.pop_back();
+  m.vertices[3].x = std::nan("");
+  try {
+    (void)build_winding_tree(m);
+    FAIL();
+  } catch (const Error& e) {
+    EXPECT_EQ(e.code(), ErrorCode::NonFinite);
+  }
+}
+
+}  // namespace
+}  // namespace levelset
