@@ -8,6 +8,7 @@
 #include <tbb/parallel_sort.h>
 
 #include "core/error.hpp"
+#include "io/validate_mesh.hpp"
 
 namespace levelset {
 
@@ -67,15 +68,7 @@ BrickTriangleLists bin_triangles_to_bricks(const TriangleMesh& mesh, const BinTr
   if (!(std::isfinite(options.margin) && options.margin >= 0))
     throw Error(ErrorCode::InvalidArgument, "margin", "must be finite and >= 0");
   const std::size_t nt = mesh.triangles.size();
-  const std::size_t nv = mesh.vertices.size();
-  for (std::size_t i = 0; i < nv; ++i)
-    if (!isfinite(mesh.vertices[i]))
-      throw Error(ErrorCode::NonFinite, "vertex " + std::to_string(i), "non-finite coordinate");
-  for (std::size_t t = 0; t < nt; ++t)
-    for (std::uint32_t v : mesh.triangles[t])
-      if (v >= nv)
-        throw Error(ErrorCode::InvalidArgument, "triangle " + std::to_string(t),
-                    "vertex index " + std::to_string(v) + " out of range");
+  validate_mesh(mesh);
 
   // Pass 1: count pairs per triangle (so the pair array is allocated once, exactly, and an
   // absurd total is refused before allocating).

@@ -16,11 +16,13 @@ std::array<std::uint16_t, 216> make_candidates() {
   int k = 0;
   for (int n = 0; n < kBrickVoxels; ++n) {
     const Coord l = local_coord(n);
-    if (l.x >= 1 && l.x <= 6 && l.y >= 1 && l.y <= 6 && l.z >= 1 && l.z <= 6) c[k++] = std::uint16_t(n);
+    if (l.x >= 1 && l.x <= 6 && l.y >= 1 && l.y <= 6 && l.z >= 1 && l.z <= 6)
+      c[k++] = std::uint16_t(n);
   }
   auto dist2 = [](int n) {
     const Coord l = local_coord(n);
-    return (2 * l.x - 7) * (2 * l.x - 7) + (2 * l.y - 7) * (2 * l.y - 7) + (2 * l.z - 7) * (2 * l.z - 7);
+    return (2 * l.x - 7) * (2 * l.x - 7) + (2 * l.y - 7) * (2 * l.y - 7) +
+           (2 * l.z - 7) * (2 * l.z - 7);
   };
   std::stable_sort(c.begin(), c.end(), [&](int a, int b) { return dist2(a) < dist2(b); });
   return c;
@@ -89,7 +91,8 @@ int jump(const BrickCrossings& x, const Coord& m, int a, int step) {
 double query(const BrickWindingContext& c, const Coord& brick, int n, std::uint64_t& queries) {
   const Coord g = brick_origin(brick) + local_coord(n);
   ++queries;
-  const Vec3d p = c.frame.origin + Vec3d{double(g.x), double(g.y), double(g.z)} * c.frame.voxel_size;
+  const Vec3d p =
+      c.frame.origin + Vec3d{double(g.x), double(g.y), double(g.z)} * c.frame.voxel_size;
   return winding_number(c.tree, p, c.beta);
 }
 
@@ -178,24 +181,28 @@ struct Adaptive {
       double smooth[8];
       for (int b = 0; b < 8; ++b) smooth[b] = value_of(corner(b)) - (wr + rel[corner(b)]);
       auto model = [&](int i, int j, int k) {
-        const double tx = double(i - lo.x) / (s - 1), ty = double(j - lo.y) / (s - 1), tz = double(k - lo.z) / (s - 1);
+        const double tx = double(i - lo.x) / (s - 1), ty = double(j - lo.y) / (s - 1),
+                     tz = double(k - lo.z) / (s - 1);
         double m = 0.0;
         for (int b = 0; b < 8; ++b)
-          m += smooth[b] * ((b & 1) ? tx : 1 - tx) * ((b & 2) ? ty : 1 - ty) * ((b & 4) ? tz : 1 - tz);
+          m += smooth[b] * ((b & 1) ? tx : 1 - tx) * ((b & 2) ? ty : 1 - ty) *
+               ((b & 4) ? tz : 1 - tz);
         return wr + rel[local_index(i, j, k)] + m;
       };
       const int c = s / 2;
-      if (std::abs(value_of(local_index(lo.x + c, lo.y + c, lo.z + c)) - model(lo.x + c, lo.y + c, lo.z + c)) <=
-          kAdaptiveTolerance) {
+      if (std::abs(value_of(local_index(lo.x + c, lo.y + c, lo.z + c)) -
+                   model(lo.x + c, lo.y + c, lo.z + c)) <= kAdaptiveTolerance) {
         for (int k = lo.z; k < lo.z + s; ++k)
           for (int j = lo.y; j < lo.y + s; ++j)
-            for (int i = lo.x; i < lo.x + s; ++i) inside.assign(local_index(i, j, k), model(i, j, k) > 0.5);
+            for (int i = lo.x; i < lo.x + s; ++i)
+              inside.assign(local_index(i, j, k), model(i, j, k) > 0.5);
         return;
       }
     }
     const int half = s / 2;
     for (int b = 0; b < 8; ++b) {
-      const Coord child{lo.x + ((b & 1) ? half : 0), lo.y + ((b & 2) ? half : 0), lo.z + ((b & 4) ? half : 0)};
+      const Coord child{lo.x + ((b & 1) ? half : 0), lo.y + ((b & 2) ? half : 0),
+                        lo.z + ((b & 4) ? half : 0)};
       solve(child, half, corner(b));
     }
   }
@@ -203,8 +210,9 @@ struct Adaptive {
 
 }  // namespace
 
-BrickMask inside_from_reference(std::span<const GridTriangle> triangles, std::span<const std::uint32_t> ids,
-                                const Coord& brick, const BrickWindingContext& context, BrickCrossings& x,
+BrickMask inside_from_reference(std::span<const GridTriangle> triangles,
+                                std::span<const std::uint32_t> ids, const Coord& brick,
+                                const BrickWindingContext& context, BrickCrossings& x,
                                 std::uint64_t& queries) {
   // Lines along z everywhere; along x and y only those of the path from the reference (its
   // x-row, the y-lines of its z-slice). A reference found next to a crossing on them is
@@ -237,8 +245,9 @@ BrickMask inside_from_reference(std::span<const GridTriangle> triangles, std::sp
   return inside;
 }
 
-BrickMask inside_adaptive(const BrickCrossings& crossings, const Coord& brick, std::span<const OpenSegment> rims,
-                          const BrickWindingContext& context, std::uint64_t& queries) {
+BrickMask inside_adaptive(const BrickCrossings& crossings, const Coord& brick,
+                          std::span<const OpenSegment> rims, const BrickWindingContext& context,
+                          std::uint64_t& queries) {
   Adaptive a{crossings, brick, rims, context, queries, {}, {}, {}, {}};
   a.solve(Coord{0, 0, 0}, kBrickDim, -1);
   return a.inside;

@@ -48,16 +48,17 @@ struct BrickWindingContext {
 };
 
 // Computes the crossings it needs into `scratch`.
-BrickMask inside_from_reference(std::span<const GridTriangle> triangles, std::span<const std::uint32_t> ids,
-                                const Coord& brick, const BrickWindingContext& context, BrickCrossings& scratch,
+BrickMask inside_from_reference(std::span<const GridTriangle> triangles,
+                                std::span<const std::uint32_t> ids, const Coord& brick,
+                                const BrickWindingContext& context, BrickCrossings& scratch,
                                 std::uint64_t& queries);
 
 // `crossings`: all lines (kAllLines).
 
-
 using OpenSegment = std::array<Vec3d, 2>;
 
-BrickMask inside_adaptive(const BrickCrossings& crossings, const Coord& brick, std::span<const OpenSegment> rims,
-                          const BrickWindingContext& context, std::uint64_t& queries);
+BrickMask inside_adaptive(const BrickCrossings& crossings, const Coord& brick,
+                          std::span<const OpenSegment> rims, const BrickWindingContext& context,
+                          std::uint64_t& queries);
 
 }  // namespace levelset

@@ -14,6 +14,7 @@
 #include "distance/unique_faces.hpp"
 #include "distance/winding_number.hpp"
 #include "geometry/point_triangle.hpp"
+#include "io/validate_mesh.hpp"
 
 namespace levelset {
 
@@ -32,12 +33,8 @@ struct BrickDistances {
 void check_budget(const TriangleMesh& mesh, const CptOptions& options) {
   if (mesh.triangles.empty())
     throw Error(ErrorCode::InvalidArgument, "mesh", "the mesh has no triangles");
+  validate_mesh(mesh);
   const BBox box = mesh.bounds();
-  if (!isfinite(box.min) || !isfinite(box.max)) {
-    for (std::size_t i = 0; i < mesh.vertices.size(); ++i)
-      if (!isfinite(mesh.vertices[i]))
-        throw Error(ErrorCode::NonFinite, "vertex " + std::to_string(i), "non-finite coordinate");
-  }
   const double h = options.frame.voxel_size;
   const double pad = 2.0 * (options.frame.half_width + 1.0);
   double voxels = 1.0;

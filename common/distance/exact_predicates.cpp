@@ -104,7 +104,8 @@ int sign(const Expansion& e) {
 }
 
 // (p * q) - (r * s) for expansions.
-Expansion cross_term(const Expansion& p, const Expansion& q, const Expansion& r, const Expansion& s) {
+Expansion cross_term(const Expansion& p, const Expansion& q, const Expansion& r,
+                     const Expansion& s) {
   return add(multiply(p, q), negate(multiply(r, s)));
 }
 
@@ -117,9 +118,12 @@ int orient2d_exact(double ax, double ay, double bx, double by, double cx, double
 }
 
 int orient3d_exact(const Vec3d& a, const Vec3d& b, const Vec3d& c, const Vec3d& d) {
-  const Expansion adx = difference(a.x, d.x), ady = difference(a.y, d.y), adz = difference(a.z, d.z);
-  const Expansion bdx = difference(b.x, d.x), bdy = difference(b.y, d.y), bdz = difference(b.z, d.z);
-  const Expansion cdx = difference(c.x, d.x), cdy = difference(c.y, d.y), cdz = difference(c.z, d.z);
+  const Expansion adx = difference(a.x, d.x), ady = difference(a.y, d.y),
+                  adz = difference(a.z, d.z);
+  const Expansion bdx = difference(b.x, d.x), bdy = difference(b.y, d.y),
+                  bdz = difference(b.z, d.z);
+  const Expansion cdx = difference(c.x, d.x), cdy = difference(c.y, d.y),
+                  cdz = difference(c.z, d.z);
   const Expansion t1 = multiply(adz, cross_term(bdx, cdy, cdx, bdy));
   const Expansion t2 = multiply(bdz, cross_term(cdx, ady, adx, cdy));
   const Expansion t3 = multiply(cdz, cross_term(adx, bdy, bdx, ady));

@@ -3,9 +3,11 @@
 //
 // Inputs: double coordinates (any units). Outputs: the exact sign (-1, 0, +1) of
 //   orient2d(a, b, c) = (ax - cx)(by - cy) - (ay - cy)(bx - cx)   (> 0: a, b, c counterclockwise)
-//   orient3d(a, b, c, d) = (a - d) . ((b - d) x (c - d))            (> 0: d behind the plane of a, b,
-//                                                                     c, which turn counterclockwise
-//                                                                     seen from the front)
+//   orient3d(a, b, c, d) = (a - d) . ((b - d) x (c - d))            (> 0: d behind the plane of a,
+//   b,
+//                                                                     c, which turn
+//                                                                     counterclockwise seen from
+//                                                                     the front)
 // Method: the caller (or the *_sign helpers) evaluates the determinant in doubles exactly as
 //   written above and trusts its sign when |det| exceeds the static bound times the permanent
 //   (kOrient2dErrorBound, kOrient3dErrorBound); otherwise the *_exact functions recompute it in
@@ -33,7 +35,8 @@ inline int orient2d_sign(double ax, double ay, double bx, double by, double cx, 
   const double left = (ax - cx) * (by - cy);
   const double right = (ay - cy) * (bx - cx);
   const double det = left - right;
-  const double bound = kOrient2dErrorBound * ((left < 0 ? -left : left) + (right < 0 ? -right : right));
+  const double bound =
+      kOrient2dErrorBound * ((left < 0 ? -left : left) + (right < 0 ? -right : right));
   if (det > bound) return 1;
   if (-det > bound) return -1;
   return orient2d_exact(ax, ay, bx, by, cx, cy);

@@ -11,8 +11,12 @@ namespace levelset {
 
 namespace {
 
-inline double abs_of(double v) { return v < 0.0 ? -v : v; }
-inline int sign_of(double v) { return v > 0.0 ? 1 : (v < 0.0 ? -1 : 0); }
+inline double abs_of(double v) {
+  return v < 0.0 ? -v : v;
+}
+inline int sign_of(double v) {
+  return v > 0.0 ? 1 : (v < 0.0 ? -1 : 0);
+}
 
 // orient2d(a, b, P) with P = p - (du, dv) equals orient2d(a, b, p) + du (bv - av) + dv (au - bu);
 // the larger infinitesimal decides first.
@@ -49,10 +53,10 @@ inline EdgeValue edge_value(double au, double av, double bu, double bv, double p
 
 // Everything one line-triangle hit needs to place its crossing along axis w.
 struct Hit {
-  Vec3d a, b, c;               // corners in (u, v, w) coordinates
-  double pu, pv;               // the line
-  EdgeValue ebc, eca, eab;     // cofactors of a, b, c
-  int tie;                     // sign of orient3d at a perturbed point exactly on the plane
+  Vec3d a, b, c;            // corners in (u, v, w) coordinates
+  double pu, pv;            // the line
+  EdgeValue ebc, eca, eab;  // cofactors of a, b, c
+  int tie;                  // sign of orient3d at a perturbed point exactly on the plane
 };
 
 // Exact sign of orient3d(a, b, c, P_m) at the perturbed centre m on the line: > 0 when the
@@ -60,8 +64,8 @@ struct Hit {
 inline int side(const Hit& h, double m, bool& on_plane) {
   const double adw = h.a.z - m, bdw = h.b.z - m, cdw = h.c.z - m;
   const double det = adw * h.ebc.value + bdw * h.eca.value + cdw * h.eab.value;
-  const double permanent = h.ebc.magnitude * abs_of(adw) + h.eca.magnitude * abs_of(bdw) +
-                           h.eab.magnitude * abs_of(cdw);
+  const double permanent =
+      h.ebc.magnitude * abs_of(adw) + h.eca.magnitude * abs_of(bdw) + h.eab.magnitude * abs_of(cdw);
   const double bound = kOrient3dErrorBound * permanent;
   if (det > bound) return 1;
   if (-det > bound) return -1;
@@ -119,8 +123,9 @@ void brick_crossings(std::span<const GridTriangle> triangles, std::span<const st
       }
       if (misses) continue;
     }
-    const int tie3 = t.normal_sign[0] != 0 ? t.normal_sign[0]
-                                           : (t.normal_sign[1] != 0 ? t.normal_sign[1] : t.normal_sign[2]);
+    const int tie3 = t.normal_sign[0] != 0
+                         ? t.normal_sign[0]
+                         : (t.normal_sign[1] != 0 ? t.normal_sign[1] : t.normal_sign[2]);
     for (int w = 0; w < 3; ++w) {
       const int sigma = t.normal_sign[w];
       if (sigma == 0 || lines[w] == 0) continue;
@@ -136,9 +141,11 @@ void brick_crossings(std::span<const GridTriangle> triangles, std::span<const st
       if (std::max({h.a.z, h.b.z, h.c.z}) < wlo || std::min({h.a.z, h.b.z, h.c.z}) > whi) continue;
       // Lines of this brick inside the projected bounding box.
       const double umin = std::max(std::ceil(std::min({h.a.x, h.b.x, h.c.x})), double(o[u]));
-      const double umax = std::min(std::floor(std::max({h.a.x, h.b.x, h.c.x})), double(o[u] + kBrickDim - 1));
+      const double umax =
+          std::min(std::floor(std::max({h.a.x, h.b.x, h.c.x})), double(o[u] + kBrickDim - 1));
       const double vmin = std::max(std::ceil(std::min({h.a.y, h.b.y, h.c.y})), double(o[v]));
-      const double vmax = std::min(std::floor(std::max({h.a.y, h.b.y, h.c.y})), double(o[v] + kBrickDim - 1));
+      const double vmax =
+          std::min(std::floor(std::max({h.a.y, h.b.y, h.c.y})), double(o[v] + kBrickDim - 1));
       if (umin > umax || vmin > vmax) continue;
       const int ju0 = int(umin) - o[u], ju1 = int(umax) - o[u];
       const int jv0 = int(vmin) - o[v], jv1 = int(vmax) - o[v];
@@ -180,8 +187,8 @@ void brick_crossings(std::span<const GridTriangle> triangles, std::span<const st
           }
           // Guess from the plane, then bisect: side(lo) == sigma, side(hi) != sigma.
           const double denom = h.ebc.value + h.eca.value + h.eab.value;
-          const double s = (h.a.z * h.ebc.value + h.b.z * h.eca.value + h.c.z * h.eab.value) / denom -
-                           wlo;
+          const double s =
+              (h.a.z * h.ebc.value + h.b.z * h.eca.value + h.c.z * h.eab.value) / denom - wlo;
           if (s > 0.0 && s < double(kBrickDim - 1)) {
             const int g = int(s);
             if (g > lo) (side(g) == sigma ? lo : hi) = g;

@@ -47,14 +47,15 @@
 namespace levelset {
 
 struct GridTriangle {
-  std::array<Vec3d, 3> corner;            // grid space
+  std::array<Vec3d, 3> corner;             // grid space
   std::array<std::int8_t, 3> normal_sign;  // exact sign of ((b - a) x (c - a))[axis]
 };
 
 // Grid-space vertices (v - origin) / h, and grid-space copies of all triangles with the exact
 // signs of their normals (TBB parallel; indices must be valid).
 std::vector<Vec3d> to_grid_vertices(const TriangleMesh& mesh, const GridFrame& frame);
-std::vector<GridTriangle> to_grid_triangles(const TriangleMesh& mesh, std::span<const Vec3d> grid_vertices);
+std::vector<GridTriangle> to_grid_triangles(const TriangleMesh& mesh,
+                                            std::span<const Vec3d> grid_vertices);
 
 struct BrickCrossings {
   std::array<std::array<std::array<std::int32_t, 8>, 64>, 3> delta{};  // [axis][line][edge]

@@ -10,6 +10,7 @@
 #include <tbb/parallel_for.h>
 
 #include "core/error.hpp"
+#include "io/validate_mesh.hpp"
 #include "distance/brick_winding.hpp"
 #include "distance/grid_crossings.hpp"
 #include "distance/open_edges.hpp"
@@ -26,7 +27,8 @@ std::size_t find_brick(const BrickTriangleLists& lists, const Coord& b) {
   const std::uint64_t key = brick_key(b);
   auto it = std::lower_bound(lists.bricks.begin(), lists.bricks.end(), key,
                              [](const Coord& c, std::uint64_t k) { return brick_key(c) < k; });
-  return it != lists.bricks.end() && brick_key(*it) == key ? std::size_t(it - lists.bricks.begin()) : nb;
+  return it != lists.bricks.end() && brick_key(*it) == key ? std::size_t(it - lists.bricks.begin())
+                                                           : nb;
 }
 
 // Open edges (open_edges.hpp) per triangle, and the bricks near them: those listing a triangle
@@ -47,7 +49,8 @@ OpenEdgeInfo find_open_edges(const TriangleMesh& mesh, std::span<const Vec3d> gr
   info.near_brick.assign(nb, false);
   std::vector<bool> counts(nt);
   for (std::size_t t = 0; t < nt; ++t)
-    counts[t] = grid[t].normal_sign[0] != 0 || grid[t].normal_sign[1] != 0 || grid[t].normal_sign[2] != 0;
+    counts[t] =
+        grid[t].normal_sign[0] != 0 || grid[t].normal_sign[1] != 0 || grid[t].normal_sign[2] != 0;
   const std::vector<std::uint32_t> welded = weld_exact(grid_vertices);
   const auto open = open_edges(mesh, welded, counts);
   info.count = open.size();
@@ -59,7 +62,8 @@ OpenEdgeInfo find_open_edges(const TriangleMesh& mesh, std::span<const Vec3d> gr
       const auto& f = mesh.triangles[t];
       for (int k = 0; k < 3; ++k) {
         const std::uint32_t a = welded[f[k]], b = welded[f[(k + 1) % 3]];
-        if (std::binary_search(open.begin(), open.end(), std::array<std::uint32_t, 2>{std::min(a, b), std::max(a, b)}))
+        if (std::binary_search(open.begin(), open.end(),
+                               std::array<std::uint32_t, 2>{std::min(a, b), std::max(a, b)}))
           info.triangle_edges[t] |= std::uint8_t(1u << k);
       }
     }
@@ -82,7 +86,8 @@ OpenEdgeInfo find_open_edges(const TriangleMesh& mesh, std::span<const Vec3d> gr
 // The open edges of the triangles listed by a brick and its 26 neighbours (every open edge
 // within the brick's width of it, given a margin >= 0), in brick-local grid coordinates.
 void gather_rims(const BrickTriangleLists& lists, std::size_t i, std::span<const GridTriangle> grid,
-                 const OpenEdgeInfo& info, std::vector<std::uint64_t>& scratch, std::vector<OpenSegment>& rims) {
+                 const OpenEdgeInfo& info, std::vector<std::uint64_t>& scratch,
+                 std::vector<OpenSegment>& rims) {
   rims.clear();
   scratch.clear();
   for (int dz = -1; dz <= 1; ++dz)
@@ -93,7 +98,8 @@ void gather_rims(const BrickTriangleLists& lists, std::size_t i, std::span<const
         for (std::uint64_t k = lists.offsets[j]; k < lists.offsets[j + 1]; ++k) {
           const std::uint32_t t = lists.triangles[k];
           for (int e = 0; e < 3; ++e)
-            if ((info.triangle_edges[t] >> e) & 1u) scratch.push_back(std::uint64_t(t) * 4 + std::uint64_t(e));
+            if ((info.triangle_edges[t] >> e) & 1u)
+              scratch.push_back(std::uint64_t(t) * 4 + std::uint64_t(e));
         }
       }
   std::sort(scratch.begin(), scratch.end());
@@ -107,22 +113,16 @@ void gather_rims(const BrickTriangleLists& lists, std::size_t i, std::span<const
   }
 }
 
-void validate(const TriangleMesh& mesh, const WindingNumberTree& tree, const BrickTriangleLists& lists,
-              const InsideMasksOptions& options) {
+void validate(const TriangleMesh& mesh, const WindingNumberTree& tree,
+              const BrickTriangleLists& lists, const InsideMasksOptions& options) {
   const GridFrame& f = options.frame;
   if (!(std::isfinite(f.voxel_size) && f.voxel_size > 0.0) || !isfinite(f.origin))
-    throw Error(ErrorCode::InvalidArgument, "frame", "voxel size must be finite and > 0, origin finite");
+    throw Error(ErrorCode::InvalidArgument, "frame",
+                "voxel size must be finite and > 0, origin finite");
   if (!(options.beta > 0.0) || !std::isfinite(options.beta))
     throw Error(ErrorCode::InvalidArgument, "beta", "must be finite and > 0");
-  const std::size_t nv = mesh.vertices.size(), nt = mesh.triangles.size();
-  for (std::size_t i = 0; i < nv; ++i)
-    if (!isfinite(mesh.vertices[i]))
-      throw Error(ErrorCode::NonFinite, "vertex " + std::to_string(i), "non-finite coordinate");
-  for (std::size_t t = 0; t < nt; ++t)
-    for (std::uint32_t v : mesh.triangles[t])
-      if (v >= nv)
-        throw Error(ErrorCode::InvalidArgument, "triangle " + std::to_string(t),
-                    "vertex index " + std::to_string(v) + " out of range");
+  const std::size_t nt = mesh.triangles.size();
+  validate_mesh(mesh);
   if (tree.order.size() != nt)
     throw Error(ErrorCode::InvalidArgument, "winding tree",
                 "built from a mesh with " + std::to_string(tree.order.size()) + " triangles, not " +
@@ -130,22 +130,28 @@ void validate(const TriangleMesh& mesh, const WindingNumberTree& tree, const Bri
   const std::size_t nb = lists.bricks.size();
   if (lists.offsets.size() != nb + 1 || lists.offsets.front() != 0 ||
       lists.offsets.back() != lists.triangles.size())
-    throw Error(ErrorCode::InvalidArgument, "brick lists", "offsets do not match bricks and triangles");
+    throw Error(ErrorCode::InvalidArgument, "brick lists",
+                "offsets do not match bricks and triangles");
   for (std::size_t i = 0; i < nb; ++i) {
     if (lists.offsets[i] > lists.offsets[i + 1])
-      throw Error(ErrorCode::InvalidArgument, "brick lists", "offsets decrease at brick " + std::to_string(i));
+      throw Error(ErrorCode::InvalidArgument, "brick lists",
+                  "offsets decrease at brick " + std::to_string(i));
     if (!brick_in_range(lists.bricks[i]))
-      throw Error(ErrorCode::InvalidArgument, "brick lists", "brick " + std::to_string(i) + " out of range");
+      throw Error(ErrorCode::InvalidArgument, "brick lists",
+                  "brick " + std::to_string(i) + " out of range");
   }
   for (std::uint32_t t : lists.triangles)
     if (t >= nt)
-      throw Error(ErrorCode::InvalidArgument, "brick lists", "triangle index " + std::to_string(t) + " out of range");
+      throw Error(ErrorCode::InvalidArgument, "brick lists",
+                  "triangle index " + std::to_string(t) + " out of range");
 }
 
 }  // namespace
 
-InsideMasksResult compute_inside_masks(const TriangleMesh& oriented_mesh, const WindingNumberTree& tree,
-                                       const BrickTriangleLists& lists, const InsideMasksOptions& options) {
+InsideMasksResult compute_inside_masks(const TriangleMesh& oriented_mesh,
+                                       const WindingNumberTree& tree,
+                                       const BrickTriangleLists& lists,
+                                       const InsideMasksOptions& options) {
   if (lists.offsets.empty() && lists.bricks.empty()) return {};
   validate(oriented_mesh, tree, lists, options);
   const GridFrame& frame = options.frame;
@@ -161,25 +167,28 @@ InsideMasksResult compute_inside_masks(const TriangleMesh& oriented_mesh, const 
   std::vector<std::uint64_t> queries(nb, 0);
   for (std::size_t start = 0; start < nb; start += kBatchBricks) {
     const std::size_t end = std::min(nb, start + kBatchBricks);
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(start, end, 4),
-                      [&](const tbb::blocked_range<std::size_t>& range) {
-      options.progress.check("sign");
-      BrickCrossings crossings;
-      std::vector<OpenSegment> rims;
-      std::vector<std::uint64_t> scratch;
-      for (std::size_t i = range.begin(); i != range.end(); ++i) {
-        const std::span<const std::uint32_t> ids(lists.triangles.data() + lists.offsets[i],
-                                                 lists.offsets[i + 1] - lists.offsets[i]);
-        if (unsafe[i]) {
-          crossings = BrickCrossings{};
-          brick_crossings(grid, ids, lists.bricks[i], kAllLines, crossings);
-          gather_rims(lists, i, grid, open, scratch, rims);
-          result.inside[i] = inside_adaptive(crossings, lists.bricks[i], rims, context, queries[i]);
-        } else {
-          result.inside[i] = inside_from_reference(grid, ids, lists.bricks[i], context, crossings, queries[i]);
-        }
-      }
-    });
+    tbb::parallel_for(
+        tbb::blocked_range<std::size_t>(start, end, 4),
+        [&](const tbb::blocked_range<std::size_t>& range) {
+          options.progress.check("sign");
+          BrickCrossings crossings;
+          std::vector<OpenSegment> rims;
+          std::vector<std::uint64_t> scratch;
+          for (std::size_t i = range.begin(); i != range.end(); ++i) {
+            const std::span<const std::uint32_t> ids(lists.triangles.data() + lists.offsets[i],
+                                                     lists.offsets[i + 1] - lists.offsets[i]);
+            if (unsafe[i]) {
+              crossings = BrickCrossings{};
+              brick_crossings(grid, ids, lists.bricks[i], kAllLines, crossings);
+              gather_rims(lists, i, grid, open, scratch, rims);
+              result.inside[i] =
+                  inside_adaptive(crossings, lists.bricks[i], rims, context, queries[i]);
+            } else {
+              result.inside[i] =
+                  inside_from_reference(grid, ids, lists.bricks[i], context, crossings, queries[i]);
+            }
+          }
+        });
     options.progress.step(double(end) / double(nb), "sign");
   }
   for (std::size_t i = 0; i < nb; ++i) {

@@ -55,13 +55,15 @@ struct InsideMasksOptions {
 };
 
 struct InsideMasksResult {
-  std::vector<BrickMask> inside;       // one per lists.bricks[i]
-  std::uint64_t winding_queries = 0;   // tree evaluations
-  std::uint64_t open_edges = 0;        // edges where the oriented surface is not closed
-  std::uint64_t direct_bricks = 0;     // bricks evaluated voxel by voxel (near open edges)
+  std::vector<BrickMask> inside;      // one per lists.bricks[i]
+  std::uint64_t winding_queries = 0;  // tree evaluations
+  std::uint64_t open_edges = 0;       // edges where the oriented surface is not closed
+  std::uint64_t direct_bricks = 0;    // bricks evaluated voxel by voxel (near open edges)
 };
 
-InsideMasksResult compute_inside_masks(const TriangleMesh& oriented_mesh, const WindingNumberTree& tree,
-                                       const BrickTriangleLists& lists, const InsideMasksOptions& options);
+InsideMasksResult compute_inside_masks(const TriangleMesh& oriented_mesh,
+                                       const WindingNumberTree& tree,
+                                       const BrickTriangleLists& lists,
+                                       const InsideMasksOptions& options);
 
 }  // namespace levelset

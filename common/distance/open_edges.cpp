@@ -35,7 +35,9 @@ std::vector<std::array<std::uint32_t, 2>> open_edges(const TriangleMesh& mesh,
   struct Use {
     std::uint64_t key;
     int direction;
-    bool operator<(const Use& o) const { return key != o.key ? key < o.key : direction < o.direction; }
+    bool operator<(const Use& o) const {
+      return key != o.key ? key < o.key : direction < o.direction;
+    }
   };
   std::vector<Use> uses;
   uses.reserve(3 * mesh.triangles.size());

@@ -9,6 +9,7 @@
 #include <tbb/parallel_sort.h>
 
 #include "core/error.hpp"
+#include "io/validate_mesh.hpp"
 #include "distance/open_edges.hpp"
 
 namespace levelset {
@@ -16,10 +17,10 @@ namespace levelset {
 namespace {
 
 struct EdgeUse {
-  std::uint64_t key;   // (min vertex << 32) | max vertex
+  std::uint64_t key;  // (min vertex << 32) | max vertex
   std::uint32_t face;
-  std::uint8_t slot;   // edge k of the face: (f[k], f[k+1])
-  bool forward;        // f[k] < f[k+1]
+  std::uint8_t slot;  // edge k of the face: (f[k], f[k+1])
+  bool forward;       // f[k] < f[k+1]
   bool operator<(const EdgeUse& o) const {
     if (key != o.key) return key < o.key;
     if (face != o.face) return face < o.face;
@@ -43,16 +44,8 @@ bool degenerate(const TriangleMesh& mesh, const std::array<std::uint32_t, 3>& f)
 
 OrientResult orient_faces(const TriangleMesh& mesh, const OrientOptions& options) {
   const std::size_t nf = mesh.triangles.size();
-  const std::size_t nv = mesh.vertices.size();
   if (nf >= 0xffffffffu) throw Error(ErrorCode::LimitExceeded, "mesh", "2^32 or more faces");
-  for (std::size_t i = 0; i < nv; ++i)
-    if (!isfinite(mesh.vertices[i]))
-      throw Error(ErrorCode::NonFinite, "vertex " + std::to_string(i), "non-finite coordinate");
-  for (std::size_t t = 0; t < nf; ++t)
-    for (std::uint32_t v : mesh.triangles[t])
-      if (v >= nv)
-        throw Error(ErrorCode::InvalidArgument, "triangle " + std::to_string(t),
-                    "vertex index " + std::to_string(v) + " out of range");
+  validate_mesh(mesh);
   OrientResult result;
   result.mesh = mesh;
   // Edges join faces through vertices at exactly equal positions (split seam vertices too).
@@ -64,7 +57,8 @@ OrientResult orient_faces(const TriangleMesh& mesh, const OrientOptions& options
   uses.reserve(3 * nf);
   for (std::size_t t = 0; t < nf; ++t) {
     const auto& f = mesh.triangles[t];
-    is_degenerate[t] = degenerate(mesh, f) || id[f[0]] == id[f[1]] || id[f[1]] == id[f[2]] || id[f[2]] == id[f[0]];
+    is_degenerate[t] =
+        degenerate(mesh, f) || id[f[0]] == id[f[1]] || id[f[1]] == id[f[2]] || id[f[2]] == id[f[0]];
     if (is_degenerate[t]) {
       ++result.degenerate_faces;
       continue;

@@ -37,12 +37,12 @@ struct OrientOptions {
 };
 
 struct OrientResult {
-  TriangleMesh mesh;                       // consistently oriented copy
-  std::uint32_t components = 0;            // connected components of non-degenerate faces
-  std::uint64_t faces_flipped = 0;         // faces whose orientation differs from the input
-  std::uint64_t degenerate_faces = 0;      // kept as they are
-  std::uint64_t nonmanifold_edges = 0;     // edges with 3 or more faces
-  std::uint64_t inconsistent_edges = 0;    // manifold edges left inconsistent (non-orientable)
+  TriangleMesh mesh;                     // consistently oriented copy
+  std::uint32_t components = 0;          // connected components of non-degenerate faces
+  std::uint64_t faces_flipped = 0;       // faces whose orientation differs from the input
+  std::uint64_t degenerate_faces = 0;    // kept as they are
+  std::uint64_t nonmanifold_edges = 0;   // edges with 3 or more faces
+  std::uint64_t inconsistent_edges = 0;  // manifold edges left inconsistent (non-orientable)
 };
 
 OrientResult orient_faces(const TriangleMesh& mesh, const OrientOptions& options);

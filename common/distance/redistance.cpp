@@ -29,18 +29,11 @@ constexpr std::size_t kMaxBricks = std::size_t{1} << 23;  // voxel ids b*512+n f
 // libm errno path.
 inline float sqrt_nonneg(float x) { return std::sqrt(x > 0.0f ? x : 0.0f); }
 
-// c ? a : b without a branch (the compiler turns float ternaries into jumps, which the data
-// in these kernels mispredicts).
-inline float select(bool c, float a, float b) {
-  const std::uint32_t m = 0u - std::uint32_t(c);
-  return std::bit_cast<float>((std::bit_cast<std::uint32_t>(a) & m) | (std::bit_cast<std::uint32_t>(b) & ~m));
-}
-
 // Godunov upwind update of |grad T| = 1 with h = 1 (thesis 2.28 / 4.4): the smallest root
 // of sum_a max(T - m_a, 0)^2 = 1, where m_a is the smaller neighbour value along axis a.
-// Only neighbours below the result take part; +inf neighbours never do. Branch-free: the
-// one-, two- and three-axis candidates are all formed (relative to the smallest value, so
-// large distances lose no precision) and the first one that stays upwind is selected.
+// Only neighbours below the result take part; +inf neighbours never do. The one-, two- and
+// three-axis candidates are all formed (relative to the smallest value, so large distances
+// lose no precision) and the first one that stays upwind is selected.
 inline float godunov(float a, float b, float c) {
   const float lo = std::min(a, b), hi = std::max(a, b);
   const float s0 = std::min(lo, c), mid = std::max(lo, c);
@@ -49,8 +42,8 @@ inline float godunov(float a, float b, float c) {
   const float t2 = 0.5f * (p + sqrt_nonneg(2.0f - p * p));
   const float pq = p + q;
   const float t3 = (pq + sqrt_nonneg(pq * pq - 3.0f * (p * p + q * q - 1.0f))) * (1.0f / 3.0f);
-  const float t = select(1.0f <= p, 1.0f, select(t2 <= q, t2, t3));
-  return select(s0 < kInf, s0 + t, kInf);
+  const float t = 1.0f <= p ? 1.0f : (t2 <= q ? t2 : t3);
+  return s0 < kInf ? s0 + t : kInf;
 }
 
 // ---------------------------------------------------------------------------------------
@@ -256,8 +249,9 @@ constexpr TileGeom<1> kGeom1{};
 constexpr TileGeom<2> kGeom2{};
 
 // ---------------------------------------------------------------------------------------
-// Interface initialisation (see the header): distance to the plane through the edge
-// crossings, from the input's values on a tile with a one-voxel halo.
+// Interface initialisation (see the header), from the input's values on a tile with a
+// one-voxel halo.
+
 // Activeness of the input's voxels on a halo-1 tile around brick src (1 = active).
 void gather_active(const NarrowBand& in, std::uint32_t src, std::uint8_t* act) {
   const Coord self = in.bricks()[src].coord;
@@ -406,8 +400,7 @@ inline void order_terms(AxisTerm& x, AxisTerm& y) {
   y = hi;
 }
 
-// Branch-free like godunov(): candidates with one, two and three axes, relative to the
-// smallest beta.
+// Like godunov(): candidates with one, two and three axes, relative to the smallest beta.
 inline float solve_terms(AxisTerm t0, AxisTerm t1, AxisTerm t2) {
   order_terms(t0, t1);
   order_terms(t1, t2);
@@ -449,20 +442,6 @@ BrickMask permute(const BrickMask& m, int flip) {
 constexpr int flip_xor(int flip) { return ((flip & 1) ? 7 : 0) | ((flip & 2) ? 56 : 0) | ((flip & 4) ? 448 : 0); }
 // The 8 orderings, opposite directions in succession.
 constexpr int kOrderings[8] = {0, 7, 1, 6, 2, 5, 3, 4};
-
-// Anti-diagonals x + y = k of a z-slice (one mask word). A sweep visits each slice diagonal
-// by diagonal instead of row by row: both orders put every voxel after its upwind neighbours
-// (x-1, y-1, z-1, and x-2, ... for the second-order stencils) and before the downwind ones,
-// so the results are identical, but the voxels of one diagonal do not depend on each other
-// and their updates overlap in the CPU instead of forming one long dependency chain.
-struct SliceDiagonals {
-  std::array<std::uint64_t, 15> mask{};
-  constexpr SliceDiagonals() {
-    for (int y = 0; y < 8; ++y)
-      for (int x = 0; x < 8; ++x) mask[x + y] |= std::uint64_t{1} << (x + 8 * y);
-  }
-};
-constexpr SliceDiagonals kDiagonals{};
 
 
 // Copies the brick's distances and `Halo` layers of each face neighbour into a tile;
@@ -552,22 +531,21 @@ void sweep_first(float* tile, const BrickMask& order_mask, int x, BrickMask& dir
   constexpr int dy = TileGeom<1>::kDim, dz = dy * dy;
   for (int w = 0; w < 8; ++w) {
     const std::uint64_t word = order_mask.words[w];
-    if (word == 0) continue;
-    for (const std::uint64_t diagonal : kDiagonals.mask) {
-      for (std::uint64_t m = word & diagonal; m != 0; m &= m - 1) {
-        const int n = ((w << 6) | std::countr_zero(m)) ^ x;
-        if (!dirty.test(n)) continue;
-        dirty.reset(n);
-        const int t = kGeom1.tile_of[n];
-        const float v = godunov(std::min(tile[t - 1], tile[t + 1]), std::min(tile[t - dy], tile[t + dy]),
-                                std::min(tile[t - dz], tile[t + dz]));
-        const float cur = tile[t];
-        if (!(v < cur)) continue;
-        tile[t] = v;
-        s.max_change = std::max(s.max_change, cur - v);
-        s.changed_faces |= kGeom1.faces[n];
-        mark_dependents<1>(dirty, n);
-      }
+    // Nothing dirty in this slice now: nothing becomes dirty while it is visited either.
+    if (word == 0 || dirty.words[(w << 6 ^ x) >> 6] == 0) continue;
+    for (std::uint64_t m = word; m != 0; m &= m - 1) {
+      const int n = ((w << 6) | std::countr_zero(m)) ^ x;
+      if (!dirty.test(n)) continue;
+      dirty.reset(n);
+      const int t = kGeom1.tile_of[n];
+      const float v = godunov(std::min(tile[t - 1], tile[t + 1]), std::min(tile[t - dy], tile[t + dy]),
+                              std::min(tile[t - dz], tile[t + dz]));
+      const float cur = tile[t];
+      if (!(v < cur)) continue;
+      tile[t] = v;
+      s.max_change = std::max(s.max_change, cur - v);
+      s.changed_faces |= kGeom1.faces[n];
+      mark_dependents<1>(dirty, n);
     }
   }
 }
@@ -579,35 +557,34 @@ void sweep_second(float* tile, const BrickMask& order_mask, int x, float toleran
   using G = TileGeom<2>;
   for (int w = 0; w < 8; ++w) {
     const std::uint64_t word = order_mask.words[w];
-    if (word == 0) continue;
-    for (const std::uint64_t diagonal : kDiagonals.mask) {
-      for (std::uint64_t m = word & diagonal; m != 0; m &= m - 1) {
-        const int n = ((w << 6) | std::countr_zero(m)) ^ x;
-        if (!dirty.test(n)) continue;
-        dirty.reset(n);
-        const int t = kGeom2.tile_of[n];
-        const float cur = tile[t];
-        const bool neg = std::signbit(cur);
-        AxisTerm terms[3];
-        for (int a = 0; a < 3; ++a) {
-          const int st = G::kStride[a];
-          const float l1 = std::abs(tile[t - st]), r1 = std::abs(tile[t + st]);
-          const bool left = l1 <= r1;
-          const float m1 = left ? l1 : r1;
-          const float v2 = tile[left ? t - 2 * st : t + 2 * st];
-          const float a2 = std::abs(v2);
-          const float m2 = std::signbit(v2) == neg ? a2 : -a2;
-          terms[a] = axis_term(m1, m2, a2 < kInf);
-        }
-        const float mag = solve_terms(terms[0], terms[1], terms[2]);
-        const float old = std::abs(cur);
-        tile[t] = neg ? -mag : mag;
-        const float change = mag < old ? old - mag : mag - old;  // NaN (inf - inf) compares false
-        if (!(change >= tolerance)) continue;
-        s.max_change = std::max(s.max_change, change);
-        s.changed_faces |= kGeom2.faces[n];
-        mark_dependents<2>(dirty, n);
+    // Nothing dirty in this slice now: nothing becomes dirty while it is visited either.
+    if (word == 0 || dirty.words[(w << 6 ^ x) >> 6] == 0) continue;
+    for (std::uint64_t m = word; m != 0; m &= m - 1) {
+      const int n = ((w << 6) | std::countr_zero(m)) ^ x;
+      if (!dirty.test(n)) continue;
+      dirty.reset(n);
+      const int t = kGeom2.tile_of[n];
+      const float cur = tile[t];
+      const bool neg = std::signbit(cur);
+      AxisTerm terms[3];
+      for (int a = 0; a < 3; ++a) {
+        const int st = G::kStride[a];
+        const float l1 = std::abs(tile[t - st]), r1 = std::abs(tile[t + st]);
+        const bool left = l1 <= r1;
+        const float m1 = left ? l1 : r1;
+        const float v2 = tile[left ? t - 2 * st : t + 2 * st];
+        const float a2 = std::abs(v2);
+        const float m2 = std::signbit(v2) == neg ? a2 : -a2;
+        terms[a] = axis_term(m1, m2, a2 < kInf);
       }
+      const float mag = solve_terms(terms[0], terms[1], terms[2]);
+      const float old = std::abs(cur);
+      tile[t] = neg ? -mag : mag;
+      const float change = mag < old ? old - mag : mag - old;  // NaN (inf - inf) compares false
+      if (!(change >= tolerance)) continue;
+      s.max_change = std::max(s.max_change, change);
+      s.changed_faces |= kGeom2.faces[n];
+      mark_dependents<2>(dirty, n);
     }
   }
 }
@@ -790,6 +767,10 @@ class TrialQueue {
     h.pop_back();
     return true;
   }
+  // The entry popped next in the current slice, if any (to prefetch its voxel).
+  const HeapEntry* peek() const {
+    return current_ < slices_.size() && !slices_[current_].empty() ? &slices_[current_].front() : nullptr;
+  }
 
  private:
   static constexpr double kSlicesPerVoxel = 256.0;
@@ -842,6 +823,10 @@ void march(Work& w, int order, double limit, const ProgressHook& progress) {
   HeapEntry e;
   while (trial.pop(e)) {
     if ((++pops & 0xffff) == 0) progress.check("redistance march");
+    if (const HeapEntry* next = trial.peek()) {  // its voxel is far away: start loading it
+      __builtin_prefetch(&w.dist[next->id]);
+      __builtin_prefetch(&tentative[next->id]);
+    }
     if (w.dist[e.id] < kInf) continue;  // accepted earlier with a smaller value
     w.dist[e.id] = e.value;
     const std::uint32_t b = e.id / kBrickVoxels;

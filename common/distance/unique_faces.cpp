@@ -27,6 +27,7 @@ UniqueFacesResult unique_faces(const TriangleMesh& mesh) {
   struct Key {
     std::array<std::uint32_t, 3> sorted;
     std::uint32_t face;
+    int orientation;  // +1 / -1: the parity of the face's vertex order against the sorted one
   };
   std::vector<Key> keys;
   keys.reserve(mesh.triangles.size());
@@ -38,20 +39,30 @@ UniqueFacesResult unique_faces(const TriangleMesh& mesh) {
       ++result.degenerate_removed;
       continue;
     }
+    // A cyclic rotation keeps the orientation; the sorted order is even or odd against it.
+    const int rot = t[0] < t[1] ? (t[0] < t[2] ? 0 : 2) : (t[1] < t[2] ? 1 : 2);
+    const std::array<std::uint32_t, 3> r = {t[rot], t[(rot + 1) % 3], t[(rot + 2) % 3]};
+    const int orientation = r[1] < r[2] ? 1 : -1;
     std::sort(t.begin(), t.end());
-    keys.push_back({t, static_cast<std::uint32_t>(f)});
+    keys.push_back({t, static_cast<std::uint32_t>(f), orientation});
   }
   std::sort(keys.begin(), keys.end(), [](const Key& a, const Key& b) {
     return a.sorted != b.sorted ? a.sorted < b.sorted : a.face < b.face;
   });
+  // Copies of a face: their orientations add up. Opposite copies cancel (a double-sided sheet
+  // encloses nothing), so a group keeps one copy of the net orientation, or none when it is 0.
   std::vector<std::uint32_t> kept;
   kept.reserve(keys.size());
-  for (std::size_t k = 0; k < keys.size(); ++k) {
-    if (k > 0 && keys[k].sorted == keys[k - 1].sorted) {
-      ++result.duplicates_removed;
-      continue;
-    }
-    kept.push_back(keys[k].face);
+  for (std::size_t k = 0; k < keys.size();) {
+    std::size_t end = k;
+    int net = 0;
+    while (end < keys.size() && keys[end].sorted == keys[k].sorted) net += keys[end++].orientation;
+    std::size_t keep = end;
+    for (std::size_t j = k; j < end && net != 0; ++j)
+      if (keys[j].orientation == (net > 0 ? 1 : -1)) { keep = j; break; }
+    if (keep != end) kept.push_back(keys[keep].face);
+    result.duplicates_removed += (end - k) - (keep != end ? 1 : 0);
+    k = end;
   }
   // Same face count and order as the input (face indices stay valid); a dropped face becomes
   // the point triangle (a, a, a), which has no area, no solid angle and no crossings.

@@ -2,9 +2,10 @@
 //
 // Input: a triangle mesh. Output: a copy whose vertices are welded where their coordinates
 // are exactly equal, in which degenerate faces (a repeated vertex after welding, or an exactly
-// zero cross product) and repeated faces (the same three welded vertices in any order; the
-// first occurrence is kept) are collapsed to a point (a, a, a), so that face indices stay
-// those of the input. Winding numbers of a soup count every copy of a face,
+// zero cross product) and repeated faces are collapsed to a point (a, a, a), so that face
+// indices stay those of the input. Copies of a face (the same three welded vertices) add up
+// by orientation: one copy of the net orientation stays, none when opposite copies cancel
+// (a double-sided sheet encloses nothing). Winding numbers of a soup count every copy of a face,
 // so a duplicated face would otherwise change inside/outside near it; distances do not
 // depend on this (the closest point transform uses the mesh as given).
 // Cost: O(V log V + F log F). Threading: serial sorts. Errors: none beyond bad_alloc.

@@ -15,6 +15,7 @@ namespace levelset {
 namespace {
 
 using Node = WindingNumberTree::Node;
+using Expansion = WindingNumberTree::Expansion;
 constexpr int kLeaf = WindingNumberTree::kLeafTriangles;
 constexpr std::size_t kParallelGrain = 4096;  // triangles below which a subtree builds serially
 
@@ -25,17 +26,19 @@ constexpr int kPairK[6] = {0, 1, 2, 1, 2, 2};
 std::size_t leaf_count(std::size_t n) {
   return n <= std::size_t(kLeaf) ? 1 : leaf_count(n / 2) + leaf_count(n - n / 2);
 }
-std::size_t node_count(std::size_t n) { return 2 * leaf_count(n) - 1; }
+std::size_t node_count(std::size_t n) {
+  return 2 * leaf_count(n) - 1;
+}
 
 struct Builder {
   const TriangleMesh& mesh;
-  std::vector<Vec3d> centroid;      // per mesh triangle
-  std::vector<double> area;         // per mesh triangle
-  std::vector<std::uint32_t> ids;   // permuted mesh triangle indices
+  std::vector<Vec3d> centroid;     // per mesh triangle
+  std::vector<double> area;        // per mesh triangle
+  std::vector<std::uint32_t> ids;  // permuted mesh triangle indices
   WindingNumberTree& tree;
 
   // Leaf moments directly from its triangles about the area-weighted centroid.
-  void make_leaf(Node& node, std::size_t lo, std::size_t hi) {
+  void make_leaf(Node& node, Expansion& ex, std::size_t lo, std::size_t hi) {
     double total = 0.0;
     Vec3d sum{}, plain{};
     for (std::size_t i = lo; i < hi; ++i) {
@@ -55,7 +58,7 @@ struct Builder {
       tree.corners[i] = {a, b, e};
       tree.order[i] = t;
       const Vec3d an = cross(b - a, e - a) * 0.5;  // area-weighted normal
-      node.normal += an;
+      ex.normal += an;
       const Vec3d g = centroid[t] - c;
       // Integral over the triangle of (x - c)(x - c)^T: a (g g^T + 1/12 sum (v - g')(v - g')^T).
       double cov[3][3];
@@ -64,9 +67,9 @@ struct Builder {
         for (int k = 0; k < 3; ++k)
           cov[j][k] = g[j] * g[k] + (v0[j] * v0[k] + v1[j] * v1[k] + v2[j] * v2[k]) / 12.0;
       for (int i3 = 0; i3 < 3; ++i3) {
-        for (int j = 0; j < 3; ++j) node.first[i3 * 3 + j] += an[i3] * g[j];
+        for (int j = 0; j < 3; ++j) ex.first[i3 * 3 + j] += an[i3] * g[j];
         // an already carries the area; cov is per unit area.
-        for (int s = 0; s < 6; ++s) node.second[i3 * 6 + s] += an[i3] * cov[kPairJ[s]][kPairK[s]];
+        for (int s = 0; s < 6; ++s) ex.second[i3 * 6 + s] += an[i3] * cov[kPairJ[s]][kPairK[s]];
       }
       for (const Vec3d* v : {&a, &b, &e}) node.radius = std::max(node.radius, length(*v - c));
     }
@@ -76,21 +79,24 @@ struct Builder {
   }
 
   // Inner node moments from its children (shifted to the node's centroid).
-  void combine(Node& node, const Node& l, const Node& r, double area_l, double area_r,
-               std::size_t lo, std::size_t hi) {
+  void combine(Node& node, Expansion& ex, std::size_t l, std::size_t r, double area_l,
+               double area_r, std::size_t lo, std::size_t hi) {
     const double total = area_l + area_r;
-    node.center = total > 0.0 ? (l.center * area_l + r.center * area_r) / total
-                              : (l.center + r.center) * 0.5;
-    node.normal = l.normal + r.normal;
-    for (const Node* child : {&l, &r}) {
-      const Vec3d d = child->center - node.center;
+    const Node& nl = tree.nodes[l];
+    const Node& nr = tree.nodes[r];
+    node.center = total > 0.0 ? (nl.center * area_l + nr.center * area_r) / total
+                              : (nl.center + nr.center) * 0.5;
+    for (std::size_t c : {l, r}) {
+      const Expansion& child = tree.expansions[c];
+      const Vec3d d = tree.nodes[c].center - node.center;
+      ex.normal += child.normal;
       for (int i = 0; i < 3; ++i) {
         for (int j = 0; j < 3; ++j)
-          node.first[i * 3 + j] += child->first[i * 3 + j] + child->normal[i] * d[j];
+          ex.first[i * 3 + j] += child.first[i * 3 + j] + child.normal[i] * d[j];
         for (int s = 0; s < 6; ++s) {
           const int j = kPairJ[s], k = kPairK[s];
-          node.second[i * 6 + s] += child->second[i * 6 + s] + child->first[i * 3 + j] * d[k] +
-                                    child->first[i * 3 + k] * d[j] + child->normal[i] * d[j] * d[k];
+          ex.second[i * 6 + s] += child.second[i * 6 + s] + child.first[i * 3 + j] * d[k] +
+                                  child.first[i * 3 + k] * d[j] + child.normal[i] * d[j] * d[k];
         }
       }
     }
@@ -106,9 +112,10 @@ struct Builder {
   // Builds the subtree of ids[lo, hi) at node index `at`; returns its total area.
   double build(std::size_t at, std::size_t lo, std::size_t hi) {
     Node& node = tree.nodes[at];
+    Expansion& ex = tree.expansions[at];
     const std::size_t n = hi - lo;
     if (n <= std::size_t(kLeaf)) {
-      make_leaf(node, lo, hi);
+      make_leaf(node, ex, lo, hi);
       double total = 0.0;
       for (std::size_t i = lo; i < hi; ++i) total += area[ids[i]];
       return total;
@@ -139,13 +146,13 @@ struct Builder {
     node.leaf = false;
     node.left = std::uint32_t(left_at);
     node.right = std::uint32_t(right_at);
-    combine(node, tree.nodes[left_at], tree.nodes[right_at], area_l, area_r, lo, hi);
+    combine(node, ex, left_at, right_at, area_l, area_r, lo, hi);
     return area_l + area_r;
   }
 };
 
 // Solid angle of a node's triangles seen from p by the second-order expansion about its centre.
-double far_field(const Node& node, const Vec3d& p) {
+double far_field(const Node& node, const Expansion& ex, const Vec3d& p) {
   const Vec3d y = node.center - p;
   const double r2 = dot(y, y);
   const double inv_r = 1.0 / std::sqrt(r2);
@@ -153,22 +160,24 @@ double far_field(const Node& node, const Vec3d& p) {
   const double inv_r3 = inv_r2 * inv_r;
   const double inv_r5 = inv_r3 * inv_r2;
   const double inv_r7 = inv_r5 * inv_r2;
-  const auto& m = node.first;
-  const auto& c = node.second;
+  const auto& m = ex.first;
+  const auto& c = ex.second;
   // Zeroth order (dipole).
-  double omega = dot(node.normal, y) * inv_r3;
+  double omega = dot(ex.normal, y) * inv_r3;
   // First order: tr(M)/r^3 - 3 y^T M y / r^5.
   double ymy = 0.0;
   for (int i = 0; i < 3; ++i)
     ymy += y[i] * (m[i * 3 + 0] * y.x + m[i * 3 + 1] * y.y + m[i * 3 + 2] * y.z);
   omega += (m[0] + m[4] + m[8]) * inv_r3 - 3.0 * ymy * inv_r5;
-  // Second order: 1/2 [ -3/r^5 (2 sum_ik C_i(ik) y_k + sum_i y_i tr C_i) + 15/r^7 sum_i y_i y^T C_i y ].
+  // Second order: 1/2 [ -3/r^5 (2 sum_ik C_i(ik) y_k + sum_i y_i tr C_i) + 15/r^7 sum_i y_i y^T C_i
+  // y ].
   double lin = 0.0, cubic = 0.0;
   for (int i = 0; i < 3; ++i) {
     const double* ci = &c[std::size_t(i) * 6];
     // Row i of the symmetric matrix C_i: entries (i, k).
     const double row[3][3] = {{ci[0], ci[3], ci[4]}, {ci[3], ci[1], ci[5]}, {ci[4], ci[5], ci[2]}};
-    lin += 2.0 * (row[i][0] * y.x + row[i][1] * y.y + row[i][2] * y.z) + y[i] * (ci[0] + ci[1] + ci[2]);
+    lin += 2.0 * (row[i][0] * y.x + row[i][1] * y.y + row[i][2] * y.z) +
+           y[i] * (ci[0] + ci[1] + ci[2]);
     const double yCy = ci[0] * y.x * y.x + ci[1] * y.y * y.y + ci[2] * y.z * y.z +
                        2.0 * (ci[3] * y.x * y.y + ci[4] * y.x * y.z + ci[5] * y.y * y.z);
     cubic += y[i] * yCy;
@@ -206,6 +215,7 @@ WindingNumberTree build_winding_tree(const TriangleMesh& mesh) {
     b.ids[t] = std::uint32_t(t);
   }
   tree.nodes.resize(node_count(nt));
+  tree.expansions.resize(tree.nodes.size());
   tree.corners.resize(nt);
   tree.order.resize(nt);
   b.build(0, 0, nt);
@@ -220,10 +230,11 @@ double winding_number(const WindingNumberTree& tree, const Vec3d& p, double beta
   stack[top++] = 0;
   double omega = 0.0;
   while (top > 0) {
-    const Node& node = tree.nodes[stack[--top]];
+    const std::uint32_t at = stack[--top];
+    const Node& node = tree.nodes[at];
     const Vec3d d = node.center - p;
     if (dot(d, d) > beta2 * node.radius * node.radius) {
-      omega += far_field(node, p);
+      omega += far_field(node, tree.expansions[at], p);
     } else if (node.leaf) {
       for (std::uint32_t i = node.left; i < node.right; ++i) {
         const auto& t = tree.corners[i];

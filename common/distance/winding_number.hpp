@@ -41,18 +41,21 @@ namespace levelset {
 
 struct WindingNumberTree {
   static constexpr int kLeafTriangles = 8;
-  struct Node {
-    Vec3d center;                  // area-weighted centroid of the node's triangles
-    double radius = 0.0;           // all vertices lie within this distance of center
-    Vec3d normal;                  // sum of area-weighted normals, 1/2 (b - a) x (c - a)
-    std::array<double, 9> first{};   // M[i*3+j] = sum a n_i (x - c)_j        (integrated)
-    std::array<double, 18> second{}; // C[i*6+s] = sum a n_i (x - c)_j (x - c)_k, s = jk in
-                                     // xx, yy, zz, xy, xz, yz               (integrated)
-    std::uint32_t left = 0;        // inner node: children left, right; leaf: triangles
-    std::uint32_t right = 0;       // [left, right) in corners
+  struct Node {               // what the traversal reads for every node it visits
+    Vec3d center;             // area-weighted centroid of the node's triangles
+    double radius = 0.0;      // all vertices lie within this distance of center
+    std::uint32_t left = 0;   // inner node: children left, right; leaf: triangles
+    std::uint32_t right = 0;  // [left, right) in corners
     bool leaf = false;
   };
+  struct Expansion {                  // what it reads for nodes it approximates
+    Vec3d normal;                     // sum of area-weighted normals, 1/2 (b - a) x (c - a)
+    std::array<double, 9> first{};    // M[i*3+j] = sum a n_i (x - c)_j        (integrated)
+    std::array<double, 18> second{};  // C[i*6+s] = sum a n_i (x - c)_j (x - c)_k, s = jk in
+                                      // xx, yy, zz, xy, xz, yz               (integrated)
+  };
   std::vector<Node> nodes;                    // nodes[0] is the root (empty mesh: no nodes)
+  std::vector<Expansion> expansions;          // per node
   std::vector<std::array<Vec3d, 3>> corners;  // triangle vertices in leaf order
   std::vector<std::uint32_t> order;           // mesh triangle index of corners[i]
 };

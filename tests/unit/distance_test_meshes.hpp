@@ -5,6 +5,7 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
+#include <limits>
 #include <map>
 #include <numbers>
 #include <random>
@@ -13,10 +14,34 @@
 #include <vector>
 
 #include "core/vec3.hpp"
+#include "geometry/point_triangle.hpp"
 #include "io/mesh_reader.hpp"
 #include "io/triangle_mesh.hpp"
 
 namespace levelset::test {
+
+// Axis-aligned box [lo, hi] as 12 outward-oriented triangles.
+inline TriangleMesh box_mesh(const Vec3d& lo, const Vec3d& hi) {
+  TriangleMesh m;
+  for (int i = 0; i < 8; ++i)
+    m.vertices.push_back({(i & 1) ? hi.x : lo.x, (i & 2) ? hi.y : lo.y, (i & 4) ? hi.z : lo.z});
+  const std::uint32_t quads[6][4] = {{0, 2, 3, 1}, {4, 5, 7, 6}, {0, 1, 5, 4},
+                                     {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}};
+  for (const auto& q : quads) {
+    m.triangles.push_back({q[0], q[1], q[2]});
+    m.triangles.push_back({q[0], q[2], q[3]});
+  }
+  return m;
+}
+
+// Exact unsigned distance to a mesh by brute force over all triangles (reference).
+inline double brute_force_distance(const TriangleMesh& m, const Vec3d& p) {
+  double best = std::numeric_limits<double>::infinity();
+  for (const auto& t : m.triangles)
+    best = std::min(best, closest_point_on_triangle(p, m.vertices[t[0]], m.vertices[t[1]],
+                                                    m.vertices[t[2]]).distance_squared);
+  return std::sqrt(best);
+}
 
 inline TriangleMesh load_cgal_mesh(const std::string& name) {
   return read_mesh(std::string(LEVELSET_CGAL_DATA) + "/meshes/" + name).mesh;
@@ -26,12 +51,13 @@ inline TriangleMesh load_cgal_mesh(const std::string& name) {
 // Faces: 20 * 4^levels.
 inline TriangleMesh icosphere(int levels, double radius = 1.0, Vec3d center = {}) {
   const double t = (1.0 + std::sqrt(5.0)) / 2.0;
-  std::vector<Vec3d> v = {{-1, t, 0}, {1, t, 0}, {-1, -t, 0}, {1, -t, 0}, {0, -1, t}, {0, 1, t},
-                          {0, -1, -t}, {0, 1, -t}, {t, 0, -1}, {t, 0, 1}, {-t, 0, -1}, {-t, 0, 1}};
+  std::vector<Vec3d> v = {{-1, t, 0}, {1, t, 0}, {-1, -t, 0}, {1, -t, 0},
+                          {0, -1, t}, {0, 1, t}, {0, -1, -t}, {0, 1, -t},
+                          {t, 0, -1}, {t, 0, 1}, {-t, 0, -1}, {-t, 0, 1}};
   std::vector<std::array<std::uint32_t, 3>> f = {
-      {0, 11, 5}, {0, 5, 1},  {0, 1, 7},   {0, 7, 10}, {0, 10, 11}, {1, 5, 9}, {5, 11, 4},
+      {0, 11, 5},  {0, 5, 1},  {0, 1, 7},  {0, 7, 10}, {0, 10, 11}, {1, 5, 9}, {5, 11, 4},
       {11, 10, 2}, {10, 7, 6}, {7, 1, 8},  {3, 9, 4},  {3, 4, 2},   {3, 2, 6}, {3, 6, 8},
-      {3, 8, 9},  {4, 9, 5},  {2, 4, 11},  {6, 2, 10}, {8, 6, 7},   {9, 8, 1}};
+      {3, 8, 9},   {4, 9, 5},  {2, 4, 11}, {6, 2, 10}, {8, 6, 7},   {9, 8, 1}};
   for (auto& p : v) p = p / length(p);
   for (int l = 0; l < levels; ++l) {
     std::map<std::pair<std::uint32_t, std::uint32_t>, std::uint32_t> mid;
@@ -67,7 +93,8 @@ inline TriangleMesh torus(double major, double minor, int nu, int nv, Vec3d cent
     for (int j = 0; j < nv; ++j) {
       const double a = 2 * std::numbers::pi * i / nu, b = 2 * std::numbers::pi * j / nv;
       m.vertices.push_back(center + Vec3d{(major + minor * std::cos(b)) * std::cos(a),
-                                          (major + minor * std::cos(b)) * std::sin(a), minor * std::sin(b)});
+                                          (major + minor * std::cos(b)) * std::sin(a),
+                                          minor * std::sin(b)});
     }
   auto id = [&](int i, int j) { return std::uint32_t(((i + nu) % nu) * nv + (j + nv) % nv); };
   for (int i = 0; i < nu; ++i)
@@ -86,8 +113,8 @@ inline TriangleMesh hemisphere(int rings, int segments, double radius = 1.0) {
     const double polar = 0.5 * std::numbers::pi * r / rings;
     for (int s = 0; s < segments; ++s) {
       const double az = 2 * std::numbers::pi * s / segments;
-      m.vertices.push_back({radius * std::sin(polar) * std::cos(az), radius * std::sin(polar) * std::sin(az),
-                            radius * std::cos(polar)});
+      m.vertices.push_back({radius * std::sin(polar) * std::cos(az),
+                            radius * std::sin(polar) * std::sin(az), radius * std::cos(polar)});
     }
   }
   auto id = [&](int r, int s) { return std::uint32_t(1 + (r - 1) * segments + (s % segments)); };
@@ -152,8 +179,8 @@ inline TriangleMesh grid_octahedron(std::array<int, 3> c, int r) {
   TriangleMesh m;
   const Vec3d o{double(c[0]), double(c[1]), double(c[2])};
   const double R = r;
-  m.vertices = {o + Vec3d{R, 0, 0}, o + Vec3d{-R, 0, 0}, o + Vec3d{0, R, 0},
-                o + Vec3d{0, -R, 0}, o + Vec3d{0, 0, R}, o + Vec3d{0, 0, -R}};
+  m.vertices = {o + Vec3d{R, 0, 0},  o + Vec3d{-R, 0, 0}, o + Vec3d{0, R, 0},
+                o + Vec3d{0, -R, 0}, o + Vec3d{0, 0, R},  o + Vec3d{0, 0, -R}};
   std::vector<std::array<std::uint32_t, 3>> f;
   for (std::uint32_t x : {0u, 1u})
     for (std::uint32_t y : {2u, 3u})
@@ -173,7 +200,8 @@ inline TriangleMesh grid_octahedron(std::array<int, 3> c, int r) {
     return mid[key] = std::uint32_t(m.vertices.size() - 1);
   };
   for (const auto& t : f) {
-    const std::uint32_t a = midpoint(t[0], t[1]), b = midpoint(t[1], t[2]), d = midpoint(t[2], t[0]);
+    const std::uint32_t a = midpoint(t[0], t[1]), b = midpoint(t[1], t[2]),
+                        d = midpoint(t[2], t[0]);
     m.triangles.push_back({t[0], a, d});
     m.triangles.push_back({t[1], b, a});
     m.triangles.push_back({t[2], d, b});

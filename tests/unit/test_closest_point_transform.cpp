@@ -9,26 +9,20 @@
 
 #include "core/error.hpp"
 #include "distance/closest_point_transform.hpp"
+#include "distance/unique_faces.hpp"
 #include "geometry/point_triangle.hpp"
 #include "grid/build_from_sdf.hpp"
 #include "io/mesh_reader.hpp"
-#include "mesh_shapes.hpp"
+#include "distance_test_meshes.hpp"
 
 namespace levelset {
-
-double test::brute_force_distance(const TriangleMesh& m, const Vec3d& p) {
-  double best = std::numeric_limits<double>::infinity();
-  for (const auto& t : m.triangles)
-    best = std::min(best, closest_point_on_triangle(p, m.vertices[t[0]], m.vertices[t[1]],
-                                                    m.vertices[t[2]]).distance_squared);
-  return std::sqrt(best);
-}
 
 namespace {
 
 using test::box_mesh;
 using test::brute_force_distance;
 using test::icosphere;
+using test::ray_parity_inside;
 
 CptResult run_cpt(const TriangleMesh& mesh, int resolution, double band = 3.0, bool closest = false) {
   CptOptions options;
@@ -92,7 +86,7 @@ TEST(ClosestPointTransform, BoxMeshGivesTheAnalyticBoxDistance) {
 
 TEST(ClosestPointTransform, SphereMeshWithinItsOwnApproximationError) {
   const double radius = 1.0;
-  const TriangleMesh mesh = icosphere({0.1, -0.2, 0.3}, radius, 4);  // 5120 faces
+  const TriangleMesh mesh = icosphere(4, radius, {0.1, -0.2, 0.3});  // 5120 faces
   // Largest gap between the sphere and its inscribed mesh (sagitta of the longest edge).
   double longest = 0;
   for (const auto& t : mesh.triangles)
@@ -107,7 +101,7 @@ TEST(ClosestPointTransform, SphereMeshWithinItsOwnApproximationError) {
 }
 
 TEST(ClosestPointTransform, IdenticalForOneAndTwoThreads) {
-  const TriangleMesh mesh = icosphere({0, 0, 0}, 1.0, 3);
+  const TriangleMesh mesh = icosphere(3, 1.0, {0, 0, 0});
   CptResult one, two;
   tbb::task_arena(1).execute([&] { one = run_cpt(mesh, 100, 3.0, true); });
   tbb::task_arena(2).execute([&] { two = run_cpt(mesh, 100, 3.0, true); });
@@ -118,7 +112,7 @@ TEST(ClosestPointTransform, IdenticalForOneAndTwoThreads) {
 }
 
 TEST(ClosestPointTransform, FlippingHalfTheFacesChangesNothing) {
-  const TriangleMesh mesh = icosphere({0, 0, 0}, 1.0, 3);
+  const TriangleMesh mesh = icosphere(3, 1.0, {0, 0, 0});
   TriangleMesh flipped = mesh;
   std::mt19937 rng(4);
   for (auto& t : flipped.triangles)
@@ -129,7 +123,7 @@ TEST(ClosestPointTransform, FlippingHalfTheFacesChangesNothing) {
 }
 
 TEST(ClosestPointTransform, DegenerateFacesAndDuplicatesDoNotChangeTheField) {
-  const TriangleMesh clean = icosphere({0, 0, 0}, 1.0, 2);
+  const TriangleMesh clean = icosphere(2, 1.0, {0, 0, 0});
   TriangleMesh dirty = clean;
   const auto n = std::uint32_t(dirty.vertices.size());
   dirty.vertices.push_back(dirty.vertices[dirty.triangles[0][0]]);  // repeated vertex
@@ -183,28 +177,10 @@ TEST(ClosestPointTransform, RejectsBadMeshes) {
   }
 }
 
+const Vec3d kRay = Vec3d{0.5773, 0.6123, 0.5401} / length(Vec3d{0.5773, 0.6123, 0.5401});
+
 std::filesystem::path cgal_mesh(const char* name) {
   return std::filesystem::path(LEVELSET_CGAL_DATA) / "meshes" / name;
-}
-
-// Ray parity: the number of crossings of a ray in a generic direction.
-bool inside_by_ray_parity(const TriangleMesh& m, const Vec3d& p) {
-  const Vec3d d = Vec3d{0.5773, 0.6123, 0.5401} / length(Vec3d{0.5773, 0.6123, 0.5401});
-  int crossings = 0;
-  for (const auto& t : m.triangles) {
-    const Vec3d a = m.vertices[t[0]], e1 = m.vertices[t[1]] - a, e2 = m.vertices[t[2]] - a;
-    const Vec3d s = cross(d, e2);
-    const double det = dot(e1, s);
-    if (std::abs(det) < 1e-300) continue;
-    const Vec3d off = p - a;
-    const double u = dot(off, s) / det;
-    if (u < 0 || u > 1) continue;
-    const Vec3d qv = cross(off, e1);
-    const double v = dot(d, qv) / det;
-    if (v < 0 || u + v > 1) continue;
-    if (dot(e2, qv) / det > 0) ++crossings;
-  }
-  return crossings % 2 == 1;
 }
 
 TEST(ClosestPointTransform, CgalKnotSignAgreesWithRayParity) {
@@ -223,7 +199,7 @@ TEST(ClosestPointTransform, CgalKnotSignAgreesWithRayParity) {
       c[a] = int(((box.min[a] + u(rng) * (box.max[a] - box.min[a])) - r.band.origin()[a]) / r.band.voxel_size());
     const Vec3d p = r.band.world(c);
     if (brute_force_distance(mesh, p) < 1e-3 * r.band.voxel_size()) continue;  // on the surface
-    const bool ref = inside_by_ray_parity(mesh, p);
+    const bool ref = ray_parity_inside(mesh, p, kRay);
     ASSERT_EQ(r.band.is_inside(c), ref) << p.x << " " << p.y << " " << p.z;
     inside += ref;
     ++checked;
@@ -252,7 +228,7 @@ TEST(ClosestPointTransform, CgalElephantWithHolesDeepInsideAndFarOutside) {
     const Vec3d p = r.band.world(c);
     const double d = brute_force_distance(closed, p);
     if (d < 6 * h) continue;
-    if (inside_by_ray_parity(closed, p)) {
+    if (ray_parity_inside(closed, p, kRay)) {
       ++deep;
       ASSERT_TRUE(r.band.is_inside(c)) << "deep inside point reported outside";
     } else {
@@ -262,6 +238,38 @@ TEST(ClosestPointTransform, CgalElephantWithHolesDeepInsideAndFarOutside) {
   }
   EXPECT_GT(deep, 30);
   EXPECT_GT(far, 300);
+}
+
+}  // namespace
+}  // namespace levelset
+
+namespace levelset {
+namespace {
+
+TEST(UniqueFaces, DuplicatesAddUpByOrientation) {
+  TriangleMesh m = test::box_mesh({0, 0, 0}, {1, 1, 1});
+  const std::size_t n = m.triangles.size();
+  m.triangles.push_back(m.triangles[0]);                                            // same copy
+  m.triangles.push_back({m.triangles[1][1], m.triangles[1][2], m.triangles[1][0]});  // rotated copy
+  m.triangles.push_back({m.triangles[2][0], m.triangles[2][2], m.triangles[2][1]});  // opposite copy
+  m.vertices.push_back(m.vertices[0]);                                              // welded twin
+  m.triangles.push_back({std::uint32_t(m.vertices.size() - 1), 0, 1});             // degenerate
+  const UniqueFacesResult r = unique_faces(m);
+  ASSERT_EQ(r.mesh.triangles.size(), m.triangles.size());  // indices preserved
+  auto collapsed = [&](std::size_t f) {
+    const auto& t = r.mesh.triangles[f];
+    return t[0] == t[1] && t[1] == t[2];
+  };
+  EXPECT_FALSE(collapsed(0));
+  EXPECT_FALSE(collapsed(1));
+  EXPECT_TRUE(collapsed(2));      // face 2 and its opposite copy cancel: both go
+  EXPECT_TRUE(collapsed(n + 2));
+  EXPECT_TRUE(collapsed(n));      // repeats of faces 0 and 1 go
+  EXPECT_TRUE(collapsed(n + 1));
+  EXPECT_TRUE(collapsed(n + 3));  // degenerate after welding
+  EXPECT_EQ(r.degenerate_removed, 1u);
+  EXPECT_EQ(r.duplicates_removed, 4u);
+  for (std::size_t f = 3; f < n; ++f) EXPECT_EQ(r.mesh.triangles[f], m.triangles[f]);
 }
 
 }  // namespace

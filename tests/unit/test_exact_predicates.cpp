@@ -23,8 +23,8 @@ int reference_orient3d(const Vec3d& a, const Vec3d& b, const Vec3d& c, const Vec
   const Rational adx = R(a.x) - R(d.x), ady = R(a.y) - R(d.y), adz = R(a.z) - R(d.z);
   const Rational bdx = R(b.x) - R(d.x), bdy = R(b.y) - R(d.y), bdz = R(b.z) - R(d.z);
   const Rational cdx = R(c.x) - R(d.x), cdy = R(c.y) - R(d.y), cdz = R(c.z) - R(d.z);
-  const Rational det = adz * (bdx * cdy - cdx * bdy) + bdz * (cdx * ady - adx * cdy) +
-                       cdz * (adx * bdy - bdx * ady);
+  const Rational det =
+      adz * (bdx * cdy - cdx * bdy) + bdz * (cdx * ady - adx * cdy) + cdz * (adx * bdy - bdx * ady);
   return det > 0 ? 1 : (det < 0 ? -1 : 0);
 }
 
@@ -38,7 +38,10 @@ TEST(ExactPredicates, Orient2dMatchesRationalsOnNearlyCollinearPoints) {
     // c on the line through a and b, rounded: the true sign is decided in the last bits.
     const double t = T(rng);
     double cx = ax + t * (bx - ax), cy = ay + t * (by - ay);
-    if (i % 4 == 0) { cx = ax; cy = ay; }  // exact degeneracy
+    if (i % 4 == 0) {
+      cx = ax;
+      cy = ay;
+    }  // exact degeneracy
     if (i % 7 == 0) cx = std::nextafter(cx, 1e9);
     const int ref = reference_orient2d(ax, ay, bx, by, cx, cy);
     ASSERT_EQ(orient2d_sign(ax, ay, bx, by, cx, cy), ref) << i;
@@ -66,8 +69,9 @@ TEST(ExactPredicates, Orient3dMatchesRationalsOnNearlyCoplanarPoints) {
     const int ref = reference_orient3d(a, b, c, d);
     ASSERT_EQ(orient3d_sign(a, b, c, d), ref) << i;
     ASSERT_EQ(orient3d_exact(a, b, c, d), ref) << i;
-    const double adx = a.x - d.x, ady = a.y - d.y, adz = a.z - d.z, bdx = b.x - d.x, bdy = b.y - d.y,
-                 bdz = b.z - d.z, cdx = c.x - d.x, cdy = c.y - d.y, cdz = c.z - d.z;
+    const double adx = a.x - d.x, ady = a.y - d.y, adz = a.z - d.z, bdx = b.x - d.x,
+                 bdy = b.y - d.y, bdz = b.z - d.z, cdx = c.x - d.x, cdy = c.y - d.y,
+                 cdz = c.z - d.z;
     const double naive = adz * (bdx * cdy - cdx * bdy) + bdz * (cdx * ady - adx * cdy) +
                          cdz * (adx * bdy - bdx * ady);
     naive_wrong += (naive > 0 ? 1 : (naive < 0 ? -1 : 0)) != ref;
@@ -97,8 +101,10 @@ TEST(SolidAngle, SignAndOctantAndPlane) {
   EXPECT_EQ(triangle_solid_angle({0.2, 0.3, 0.0}, {0, 0, 0}, ex, ey), 0.0);
   EXPECT_EQ(triangle_solid_angle({0.2, 0.3, 0.7}, {0, 0, 0}, ex, ex * 2.0), 0.0);
   // Just behind / in front of the centre: +-2 pi in the limit.
-  EXPECT_NEAR(triangle_solid_angle({0.25, 0.25, -1e-9}, {0, 0, 0}, ex, ey), 2 * std::numbers::pi, 1e-6);
-  EXPECT_NEAR(triangle_solid_angle({0.25, 0.25, 1e-9}, {0, 0, 0}, ex, ey), -2 * std::numbers::pi, 1e-6);
+  EXPECT_NEAR(triangle_solid_angle({0.25, 0.25, -1e-9}, {0, 0, 0}, ex, ey), 2 * std::numbers::pi,
+              1e-6);
+  EXPECT_NEAR(triangle_solid_angle({0.25, 0.25, 1e-9}, {0, 0, 0}, ex, ey), -2 * std::numbers::pi,
+              1e-6);
 }
 
 }  // namespace

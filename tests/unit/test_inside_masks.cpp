@@ -4,6 +4,8 @@
 #include <cstdlib>
 #include <memory>
 #include <random>
+#include <utility>
+#include <vector>
 
 #include <tbb/task_arena.h>
 
@@ -13,6 +15,7 @@
 #include "distance/orient_faces.hpp"
 #include "distance/winding_number.hpp"
 #include "distance_test_meshes.hpp"
+#include "geometry/point_triangle.hpp"
 
 namespace levelset {
 namespace {
@@ -29,7 +32,8 @@ struct Masks {
       const Coord o = brick_origin(lists.bricks[i]);
       for (int n = 0; n < kBrickVoxels; ++n) {
         const Coord g = o + local_coord(n);
-        const Vec3d p = frame.origin + Vec3d{double(g.x), double(g.y), double(g.z)} * frame.voxel_size;
+        const Vec3d p =
+            frame.origin + Vec3d{double(g.x), double(g.y), double(g.z)} * frame.voxel_size;
         f(p, g, result.inside[i].test(n));
       }
     }
@@ -70,13 +74,23 @@ TEST(InsideMasks, IcosphereMatchesThePointInPolyhedronOnEveryVoxel) {
   ASSERT_EQ(sphere.triangles.size(), 5120u);
   const Masks m = compute(sphere, 0.1, {0.0, 0.0, 0.0});
   ASSERT_GT(m.lists.bricks.size(), 50u);
-  const WindingNumberTree tree = build_winding_tree(sphere);
+  // The icosphere is convex: inside iff behind every face plane (no voxel lies near one at this
+  // generic offset), checked on every voxel; the brute-force winding number on a sample.
+  std::vector<std::pair<Vec3d, Vec3d>> planes;  // (point, outward normal)
+  for (const auto& f : sphere.triangles) {
+    const Vec3d& a = sphere.vertices[f[0]];
+    planes.push_back({a, cross(sphere.vertices[f[1]] - a, sphere.vertices[f[2]] - a)});
+  }
   std::mt19937 rng(1);
   std::size_t checked = 0, exact_checked = 0, inside = 0;
   m.for_each_voxel([&](const Vec3d& p, const Coord&, bool bit) {
-    const double w = winding_number(tree, p);
-    ASSERT_LT(std::abs(w - std::round(w)), 0.01) << "reference ambiguous";
-    ASSERT_EQ(bit, w > 0.5) << p.x << " " << p.y << " " << p.z;
+    bool behind_all = true;
+    for (const auto& [a, n] : planes)
+      if (!(dot(n, p - a) < 0.0)) {
+        behind_all = false;
+        break;
+      }
+    ASSERT_EQ(bit, behind_all) << p.x << " " << p.y << " " << p.z;
     if (rng() % 64 == 0) {
       ASSERT_EQ(bit, winding_number_exact(sphere, p) > 0.5);
       ++exact_checked;
@@ -147,6 +161,31 @@ TEST(InsideMasks, GridAlignedOctahedronFollowsTheSymbolicPerturbation) {
     on_surface += std::abs(g.x - c[0]) + std::abs(g.y - c[1]) + std::abs(g.z - c[2]) == r;
   });
   EXPECT_EQ(on_surface, 4u * r * r + 2u);  // lattice points on the surface
+}
+
+TEST(InsideMasks, SphereSnappedToGridPointsFollowsTheSymbolicPerturbation) {
+  // Every vertex on a voxel centre: faces, edges and vertices through voxel centres in all
+  // directions, folds and zero-area faces from the snapping. Reference: the exact winding
+  // number at p - (e1, e2, e3) emulated with (1e-4, 1e-8, 1e-12) voxels, faithful here because
+  // normals are small integer vectors (|n_i| <= 2 * 16^2) and plane offsets integers.
+  for (double radius : {6.3, 9.7}) {
+    TriangleMesh m = test::icosphere(2, radius, {8.2, 7.9, 8.4});
+    for (auto& v : m.vertices) v = Vec3d{std::round(v.x), std::round(v.y), std::round(v.z)};
+    const Masks masks = compute(m, 1.0, {0, 0, 0});
+    std::size_t on_surface = 0;
+    masks.for_each_voxel([&](const Vec3d& p, const Coord&, bool bit) {
+      const Vec3d q = p - Vec3d{1e-4, 1e-8, 1e-12};
+      ASSERT_EQ(bit, winding_number_exact(m, q) > 0.5)
+          << radius << ": " << p.x << " " << p.y << " " << p.z;
+      for (const auto& f : m.triangles)
+        if (closest_point_on_triangle(p, m.vertices[f[0]], m.vertices[f[1]], m.vertices[f[2]])
+                .distance_squared == 0.0) {
+          ++on_surface;
+          break;
+        }
+    });
+    EXPECT_GT(on_surface, 40u);
+  }
 }
 
 TEST(InsideMasks, OverlappingSpheresSoupIsTheirUnion) {
@@ -252,15 +291,19 @@ TEST(InsideMasks, CancelsAndRejectsInconsistentInput) {
       EXPECT_EQ(e.code(), code) << e.what();
     }
   };
-  expect_code([&] { (void)compute_inside_masks(sphere, tree, lists, options); }, ErrorCode::Cancelled);
+  expect_code([&] { (void)compute_inside_masks(sphere, tree, lists, options); },
+              ErrorCode::Cancelled);
   options.progress = {};
   const WindingNumberTree other = build_winding_tree(test::icosphere(1));
-  expect_code([&] { (void)compute_inside_masks(sphere, other, lists, options); }, ErrorCode::InvalidArgument);
+  expect_code([&] { (void)compute_inside_masks(sphere, other, lists, options); },
+              ErrorCode::InvalidArgument);
   BrickTriangleLists broken = lists;
   broken.triangles[0] = 1u << 30;
-  expect_code([&] { (void)compute_inside_masks(sphere, tree, broken, options); }, ErrorCode::InvalidArgument);
+  expect_code([&] { (void)compute_inside_masks(sphere, tree, broken, options); },
+              ErrorCode::InvalidArgument);
   options.frame.voxel_size = 0.0;
-  expect_code([&] { (void)compute_inside_masks(sphere, tree, lists, options); }, ErrorCode::InvalidArgument);
+  expect_code([&] { (void)compute_inside_masks(sphere, tree, lists, options); },
+              ErrorCode::InvalidArgument);
   // No bricks: no masks.
   options.frame.voxel_size = 0.05;
   EXPECT_TRUE(compute_inside_masks(sphere, tree, BrickTriangleLists{}, options).inside.empty());

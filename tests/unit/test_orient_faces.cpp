@@ -26,7 +26,8 @@ void expect_consistent(const TriangleMesh& m, const std::string& what) {
   for (const auto& [e, n] : undirected) {
     if (n != 2) continue;
     ++manifold;
-    EXPECT_EQ(directed[std::make_pair(e.first, e.second)], 1) << what << " edge " << e.first << "-" << e.second;
+    EXPECT_EQ(directed[std::make_pair(e.first, e.second)], 1)
+        << what << " edge " << e.first << "-" << e.second;
   }
   EXPECT_GT(manifold, 0) << what;
 }
@@ -127,7 +128,7 @@ TEST(OrientFaces, ComponentsDegenerateAndNonManifoldFaces) {
   for (auto f : b.triangles) m.triangles.push_back({f[0] + off, f[1] + off, f[2] + off});
   const std::size_t spheres = m.triangles.size();
   const std::uint32_t e0 = m.triangles[0][0], e1 = m.triangles[0][1];  // an edge of sphere a
-  m.triangles.push_back({e0, e0, e1});  // repeated index
+  m.triangles.push_back({e0, e0, e1});                                 // repeated index
   m.vertices.push_back(m.vertices[e0]);  // a distinct index at the same position
   m.triangles.push_back({e0, e1, std::uint32_t(m.vertices.size() - 1)});  // zero area
   // A fin on edge (e0, e1) makes that edge non-manifold (three non-degenerate faces).
@@ -142,8 +143,10 @@ TEST(OrientFaces, ComponentsDegenerateAndNonManifoldFaces) {
   TriangleMesh first, second;
   first.vertices = second.vertices = r.mesh.vertices;
   for (auto& v : second.vertices) v -= Vec3d{5, 0, 0};
-  for (std::size_t t = 0; t < a.triangles.size(); ++t) first.triangles.push_back(r.mesh.triangles[t]);
-  for (std::size_t t = a.triangles.size(); t < spheres; ++t) second.triangles.push_back(r.mesh.triangles[t]);
+  for (std::size_t t = 0; t < a.triangles.size(); ++t)
+    first.triangles.push_back(r.mesh.triangles[t]);
+  for (std::size_t t = a.triangles.size(); t < spheres; ++t)
+    second.triangles.push_back(r.mesh.triangles[t]);
   EXPECT_GT(test::signed_volume6(first), 0.0);
   EXPECT_GT(test::signed_volume6(second), 0.0);
   expect_consistent(first, "first");

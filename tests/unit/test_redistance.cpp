@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdio>
 #include <limits>
+#include <map>
 #include <memory>
 #include <string>
 
@@ -51,13 +52,31 @@ struct Quality {
   std::size_t grad_samples = 0, crossings = 0;
 };
 
-Quality measure(const NarrowBand& in, const NarrowBand& out, const AnalyticShape& shape) {
+// The exact distance at a voxel: from `cache` (a band of the exact SDF on the same frame,
+// float-rounded) where it has the voxel, else from the shape (the knot's SDF is slow).
+struct ExactDistance {
+  const AnalyticShape& shape;
+  const NarrowBand& frame;
+  const NarrowBand* cache;
+  BandAccessor acc;
+  ExactDistance(const AnalyticShape& s, const NarrowBand& f, const NarrowBand* c)
+      : shape(s), frame(f), cache(c), acc(c ? *c : f) {}
+  double operator()(const Coord& c) {
+    if (cache)
+      if (const auto v = acc.probe(c)) return *v;
+    return shape.distance(frame.world(c));
+  }
+};
+
+Quality measure(const NarrowBand& in, const NarrowBand& out, const AnalyticShape& shape,
+                const NarrowBand* exact_band = nullptr) {
   Quality q;
   const double h = out.voxel_size();
   BandAccessor acc(out), acc_in(in);
+  ExactDistance exact(shape, out, exact_band);
   static constexpr Coord kAxis[3] = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
   out.for_each_active([&](const Coord& c, float v) {
-    q.value_error = std::max(q.value_error, std::abs(v - shape.distance(out.world(c))) / h);
+    q.value_error = std::max(q.value_error, std::abs(v - exact(c)) / h);
     double g2 = 0, e2 = 0;
     bool full = true, interface = false;
     for (int a = 0; a < 3; ++a) {
@@ -65,7 +84,7 @@ Quality measure(const NarrowBand& in, const NarrowBand& out, const AnalyticShape
       if (!p || !m) { full = false; break; }
       interface |= (*p < 0) != (v < 0) || (*m < 0) != (v < 0);
       const double g = (double(*p) - double(*m)) / (2 * h);
-      const double e = (shape.distance(out.world(c + kAxis[a])) - shape.distance(out.world(c - kAxis[a]))) / (2 * h);
+      const double e = (exact(c + kAxis[a]) - exact(c - kAxis[a])) / (2 * h);
       g2 += g * g;
       e2 += e * e;
     }
@@ -104,18 +123,31 @@ void print(const std::string& what, RedistanceMethod m, const Quality& q, const 
               q.grad_error_interface, q.crossing_shift, q.crossings);
 }
 
-// Signs against the exact shape and the band invariant, in a box around the band.
-void expect_signs_and_invariant(const NarrowBand& out, const AnalyticShape& shape, int margin) {
+// Signs against the exact shape and the band invariant, in a box around the band. The exact
+// sign of a voxel is the sample build_from_sdf took of the shape's SDF in `exact` (same
+// frame) where `exact` has the brick, else one SDF sample at the brick's centre: a brick
+// the exact band lacks holds no voxel within W*h >= h of the surface, so it has one sign.
+void expect_signs_and_invariant(const NarrowBand& out, const AnalyticShape& shape, const NarrowBand& exact,
+                                int margin) {
   IndexBox box = out.active_index_bounds();
   ASSERT_FALSE(box.empty());
   BandAccessor acc(out);
+  std::map<std::uint64_t, bool> far_sign;
+  auto exact_inside = [&](const Coord& c) {
+    const Coord bc = brick_of(c);
+    const std::uint32_t b = exact.find_brick(bc);
+    if (b != kNoBrick) return exact.voxel_inside(b, local_index(c));
+    auto [it, added] = far_sign.try_emplace(brick_key(bc), false);
+    if (added) it->second = shape.distance(exact.world(brick_origin(bc) + Coord{4, 4, 4})) < 0.0;
+    return it->second;
+  };
   std::size_t wrong_sign = 0, broken = 0;
   for (int z = box.min.z - margin; z <= box.max.z + margin; ++z)
     for (int y = box.min.y - margin; y <= box.max.y + margin; ++y)
       for (int x = box.min.x - margin; x <= box.max.x + margin; ++x) {
         const Coord c{x, y, z};
         const bool inside = acc.is_inside(c);
-        wrong_sign += inside != (float(shape.distance(out.world(c))) < 0.0f);
+        wrong_sign += inside != exact_inside(c);
         for (const Coord d : {Coord{1, 0, 0}, Coord{0, 1, 0}, Coord{0, 0, 1}}) {
           if (acc.is_inside(c + d) != inside) broken += !acc.is_active(c) || !acc.is_active(c + d);
         }
@@ -130,37 +162,42 @@ TEST_P(RedistanceShapes, DistortedSphere) {
   const auto sb = make_shape_band("sphere", 128);
   const NarrowBand in = distort(sb.band);
   const RedistanceResult r = run(in, GetParam());
-  const Quality q = measure(in, r.band, *sb.shape);
+  const Quality q = measure(in, r.band, *sb.shape, &sb.band);
   print("sphere R=128", GetParam(), q, r);
   EXPECT_GT(q.grad_samples, 10000u);
   EXPECT_LT(q.value_error, 0.05);
   EXPECT_LT(q.grad_error, 1e-2);
   EXPECT_LT(q.crossing_shift, 0.05);
-  expect_signs_and_invariant(r.band, *sb.shape, 6);
+  // What the second-order scheme and the Taylor initialisation reach (measured 0.001 h and
+  // 0.0003): a regression guard well below the targets above.
+  EXPECT_LT(q.value_error, 0.005);
+  EXPECT_LT(q.grad_error, 0.002);
+  EXPECT_LT(q.grad_error_interface, 0.005);
+  expect_signs_and_invariant(r.band, *sb.shape, sb.band, 6);
 }
 
 TEST_P(RedistanceShapes, DistortedTorus) {
   const auto sb = make_shape_band("torus", 192);
   const NarrowBand in = distort(sb.band);
   const RedistanceResult r = run(in, GetParam());
-  const Quality q = measure(in, r.band, *sb.shape);
+  const Quality q = measure(in, r.band, *sb.shape, &sb.band);
   print("torus R=192", GetParam(), q, r);
   EXPECT_LT(q.value_error, 0.05);
   EXPECT_LT(q.grad_error, 1e-2);
   EXPECT_LT(q.crossing_shift, 0.05);
-  expect_signs_and_invariant(r.band, *sb.shape, 4);
+  expect_signs_and_invariant(r.band, *sb.shape, sb.band, 4);
 }
 
 TEST_P(RedistanceShapes, DistortedKnot) {
   const auto sb = make_shape_band("knot", 256);
   const NarrowBand in = distort(sb.band);
   const RedistanceResult r = run(in, GetParam());
-  const Quality q = measure(in, r.band, *sb.shape);
+  const Quality q = measure(in, r.band, *sb.shape, &sb.band);
   print("knot R=256", GetParam(), q, r);
   EXPECT_LT(q.value_error, 0.05);
   EXPECT_LT(q.grad_error, 1e-2);
   EXPECT_LT(q.crossing_shift, 0.05);
-  expect_signs_and_invariant(r.band, *sb.shape, 2);
+  expect_signs_and_invariant(r.band, *sb.shape, sb.band, 2);
 }
 
 INSTANTIATE_TEST_SUITE_P(Redistance, RedistanceShapes,
@@ -218,10 +255,10 @@ TEST_P(RedistanceShapes, GrowingMatchesBuildingWide) {
   // plane (first order in the curvature), so values differ by that error at most.
   EXPECT_LT(d.max_diff, 0.05);
   EXPECT_GT(d.min_only_one, 4.8);  // only voxels at the band's edge may be in one only
-  const Quality q = measure(distort(narrow), grown.band, *shape);
+  const Quality q = measure(distort(narrow), grown.band, *shape, &wide.band);
   EXPECT_LT(q.value_error, 0.05);
   EXPECT_LT(q.grad_error, 1e-2);
-  expect_signs_and_invariant(grown.band, *shape, 3);
+  expect_signs_and_invariant(grown.band, *shape, wide.band, 3);
 }
 
 TEST_P(RedistanceShapes, ShrinkingKeepsTheInnerBand) {
@@ -251,7 +288,7 @@ TEST_P(RedistanceShapes, ShrinkingKeepsTheInnerBand) {
   // second-order stencils may miss a value beyond the cut.
   EXPECT_LT(max_diff, GetParam() == RedistanceMethod::Sweep ? 1e-7 : 1e-3);
   EXPECT_LT(shrunk.band.brick_count(), full.band.brick_count());
-  expect_signs_and_invariant(shrunk.band, *wide.shape, 3);
+  expect_signs_and_invariant(shrunk.band, *wide.shape, wide.band, 3);
 }
 
 TEST_P(RedistanceShapes, BitIdenticalForAnyThreadCount) {
@@ -273,9 +310,9 @@ TEST_P(RedistanceShapes, ExactDistanceIsNearlyAFixedPoint) {
   const BandDiff d2 = compare(r.band, again.band);
   std::printf("[fixed point %s] exact input: max change %.4f h; second pass: max change %.4f h\n", name(GetParam()),
               d.max_diff, d2.max_diff);
-  EXPECT_LT(d.max_diff, 0.02);
+  EXPECT_LT(d.max_diff, 0.01);
   EXPECT_GT(d.min_only_one, 2.9);
-  EXPECT_LT(d2.max_diff, 0.01);
+  EXPECT_LT(d2.max_diff, 0.002);
 }
 
 TEST_P(RedistanceShapes, FirstOrderIsCoarserButConsistent) {
@@ -285,7 +322,7 @@ TEST_P(RedistanceShapes, FirstOrderIsCoarserButConsistent) {
   o.method = GetParam();
   o.order = 1;
   const RedistanceResult r = redistance(in, o);
-  const Quality q = measure(in, r.band, *sb.shape);
+  const Quality q = measure(in, r.band, *sb.shape, &sb.band);
   print("sphere R=128 first order", GetParam(), q, r);
   EXPECT_LT(q.value_error, 0.05);
   EXPECT_LT(q.grad_error, 0.02);

@@ -17,8 +17,9 @@ namespace {
 double distance_to_mesh(const TriangleMesh& m, const Vec3d& p) {
   double best = 1e300;
   for (const auto& f : m.triangles)
-    best = std::min(best, closest_point_on_triangle(p, m.vertices[f[0]], m.vertices[f[1]], m.vertices[f[2]])
-                              .distance_squared);
+    best = std::min(
+        best, closest_point_on_triangle(p, m.vertices[f[0]], m.vertices[f[1]], m.vertices[f[2]])
+                  .distance_squared);
   return std::sqrt(best);
 }
 
@@ -93,9 +94,11 @@ TEST(WindingNumber, ErrorShrinksWithBeta) {
   const double betas[3] = {1.0, 2.0, 4.0};
   for (int i = 0; i < 300; ++i) {
     // Anywhere in the box, close to the surface or not.
-    const Vec3d p = box.min + Vec3d{box.extent().x * U(rng), box.extent().y * U(rng), box.extent().z * U(rng)};
+    const Vec3d p =
+        box.min + Vec3d{box.extent().x * U(rng), box.extent().y * U(rng), box.extent().z * U(rng)};
     const double exact = winding_number_exact(m, p);
-    for (int b = 0; b < 3; ++b) worst[b] = std::max(worst[b], std::abs(winding_number(tree, p, betas[b]) - exact));
+    for (int b = 0; b < 3; ++b)
+      worst[b] = std::max(worst[b], std::abs(winding_number(tree, p, betas[b]) - exact));
   }
   EXPECT_LT(worst[2], worst[1]);
   EXPECT_LT(worst[1], worst[0]);
@@ -123,7 +126,7 @@ TEST(WindingNumber, SoupsFlippedFacesAndEmptyMesh) {
   EXPECT_EQ(one.order, two.order);
   for (std::size_t i = 0; i < one.nodes.size(); ++i) {
     EXPECT_EQ(one.nodes[i].center, two.nodes[i].center);
-    EXPECT_EQ(one.nodes[i].second, two.nodes[i].second);
+    EXPECT_EQ(one.expansions[i].second, two.expansions[i].second);
   }
 }
 
