@@ -47,9 +47,11 @@ void check_budget(const TriangleMesh& mesh, const CptOptions& options) {
 }
 
 // Scan-converts the slab of one triangle within one brick and keeps per-voxel minima.
+// dist2 / dist: the best squared distance and distance per voxel so far (dist is kept for
+// the cheap bounding-sphere rejection below).
 void scan_triangle(const Vec3d& a, const Vec3d& b, const Vec3d& c, std::uint32_t tri,
                    const Coord& brick, const GridFrame& frame, double band2, double* dist2,
-                   std::uint32_t* owner) {
+                   double* dist, std::uint32_t* owner) {
   const double h = frame.voxel_size;
   const double r = frame.half_width * h * (1.0 + 1e-12) + 1e-12 * h;  // inclusive at the rim
   const Coord o = brick_origin(brick);
@@ -72,6 +74,10 @@ void scan_triangle(const Vec3d& a, const Vec3d& b, const Vec3d& c, std::uint32_t
   }
   const int u = (axis + 1) % 3, v = (axis + 2) % 3;
   const bool slab = len > 0.0 && std::abs(n[axis]) > 1e-3;
+  // Bounding sphere: |p - centre| - radius bounds the triangle distance from below.
+  const Vec3d centre = (a + b + c) / 3.0;
+  const double radius = std::sqrt(std::max(dot(a - centre, a - centre),
+                                           std::max(dot(b - centre, b - centre), dot(c - centre, c - centre))));
   for (int jv = lo[v]; jv <= hi[v]; ++jv) {
     for (int ju = lo[u]; ju <= hi[u]; ++ju) {
       int k0 = lo[axis], k1 = hi[axis];
@@ -92,7 +98,10 @@ void scan_triangle(const Vec3d& a, const Vec3d& b, const Vec3d& c, std::uint32_t
         p[axis] = frame.origin[axis] + (o[axis] + k) * h;
         l[axis] = k;
         const int idx = local_index(l.x, l.y, l.z);
-        // The plane distance bounds the triangle distance from below: skip hopeless voxels.
+        // Lower bounds first (sphere, then plane): skip voxels this triangle cannot improve.
+        const Vec3d pc = p - centre;
+        const double reach = radius + dist[idx];
+        if (dot(pc, pc) >= reach * reach) continue;
         if (slab) {
           const double pd = dot(n, p - a);
           if (pd * pd >= dist2[idx]) continue;
@@ -100,6 +109,7 @@ void scan_triangle(const Vec3d& a, const Vec3d& b, const Vec3d& c, std::uint32_t
         const double d2 = closest_point_on_triangle(p, a, b, c).distance_squared;
         if (d2 <= band2 && d2 < dist2[idx]) {
           dist2[idx] = d2;
+          dist[idx] = std::sqrt(d2);
           owner[idx] = tri;
         }
       }
@@ -145,15 +155,16 @@ CptResult closest_point_transform(const TriangleMesh& mesh, const CptOptions& op
     const std::size_t end = std::min(nb, start + batch);
     tbb::parallel_for(tbb::blocked_range<std::size_t>(start, end, 4),
                       [&](const tbb::blocked_range<std::size_t>& range) {
-      double dist2[kBrickVoxels];
+      double dist2[kBrickVoxels], dist[kBrickVoxels];
       std::uint32_t owner[kBrickVoxels];
       for (std::size_t i = range.begin(); i != range.end(); ++i) {
         std::fill(dist2, dist2 + kBrickVoxels, std::numeric_limits<double>::infinity());
+        std::fill(dist, dist + kBrickVoxels, std::numeric_limits<double>::infinity());
         for (std::uint64_t k = lists.offsets[i]; k < lists.offsets[i + 1]; ++k) {
           const std::uint32_t tri = lists.triangles[k];
           const auto& f = mesh.triangles[tri];
           scan_triangle(mesh.vertices[f[0]], mesh.vertices[f[1]], mesh.vertices[f[2]], tri,
-                        lists.bricks[i], options.frame, band2, dist2, owner);
+                        lists.bricks[i], options.frame, band2, dist2, dist, owner);
         }
         BrickDistances& out = per_brick[i];
         const Coord o = brick_origin(lists.bricks[i]);

@@ -767,10 +767,6 @@ class TrialQueue {
     h.pop_back();
     return true;
   }
-  // The entry popped next in the current slice, if any (to prefetch its voxel).
-  const HeapEntry* peek() const {
-    return current_ < slices_.size() && !slices_[current_].empty() ? &slices_[current_].front() : nullptr;
-  }
 
  private:
   static constexpr double kSlicesPerVoxel = 256.0;
@@ -823,10 +819,6 @@ void march(Work& w, int order, double limit, const ProgressHook& progress) {
   HeapEntry e;
   while (trial.pop(e)) {
     if ((++pops & 0xffff) == 0) progress.check("redistance march");
-    if (const HeapEntry* next = trial.peek()) {  // its voxel is far away: start loading it
-      __builtin_prefetch(&w.dist[next->id]);
-      __builtin_prefetch(&tentative[next->id]);
-    }
     if (w.dist[e.id] < kInf) continue;  // accepted earlier with a smaller value
     w.dist[e.id] = e.value;
     const std::uint32_t b = e.id / kBrickVoxels;

@@ -37,7 +37,7 @@ int run_cpt(const CptArgs& args) {
   const LsgWriteResult written = save_lsg(cpt.band, args.output, write_options);
   const auto t3 = std::chrono::steady_clock::now();
 
-  std::printf("%s: %zu triangles -> %zu active voxels in %zu bricks, voxel size %.6g, %.3f s -> %s (%s)\n",
+  std::fprintf(summary_stream(args.stats), "%s: %zu triangles -> %zu active voxels in %zu bricks, voxel size %.6g, %.3f s -> %s (%s)\n",
               args.mesh.c_str(), read.mesh.triangles.size(), cpt.band.active_voxel_count(),
               cpt.band.brick_count(), cpt.band.voxel_size(), std::chrono::duration<double>(t2 - t1).count(),
               args.output.c_str(), human_bytes(written.file_bytes).c_str());

@@ -24,7 +24,7 @@ int run_primitive(const PrimitiveArgs& args) {
   const auto t2 = std::chrono::steady_clock::now();
 
   const NarrowBand& band = built.band;
-  std::printf("%s: %zu active voxels in %zu bricks, voxel size %.6g, %s in memory -> %s (%s)\n",
+  std::fprintf(summary_stream(args.stats), "%s: %zu active voxels in %zu bricks, voxel size %.6g, %s in memory -> %s (%s)\n",
               args.shape.c_str(), band.active_voxel_count(), band.brick_count(), band.voxel_size(),
               human_bytes(band.memory_bytes()).c_str(), args.output.c_str(),
               human_bytes(written.file_bytes).c_str());

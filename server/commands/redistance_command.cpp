@@ -24,7 +24,7 @@ int run_redistance(const RedistanceArgs& args) {
   const auto t3 = std::chrono::steady_clock::now();
   auto secs = [](auto a, auto b) { return std::chrono::duration<double>(b - a).count(); };
 
-  std::printf("%s: %zu -> %zu active voxels (%s), %.3f s -> %s (%s)\n", args.input.c_str(),
+  std::fprintf(summary_stream(args.stats), "%s: %zu -> %zu active voxels (%s), %.3f s -> %s (%s)\n", args.input.c_str(),
               in.band.active_voxel_count(), result.band.active_voxel_count(), args.method.c_str(),
               secs(t1, t2), args.output.c_str(), human_bytes(written.file_bytes).c_str());
   Stats stats;

@@ -27,6 +27,10 @@ void write_stats(const Stats& stats, const std::string& path) {
   }
 }
 
+std::FILE* summary_stream(const std::string& stats_path) {
+  return stats_path == "-" ? stderr : stdout;
+}
+
 std::string human_bytes(std::uint64_t bytes) {
   char buf[64];
   if (bytes < 1024) {

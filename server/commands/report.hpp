@@ -7,6 +7,7 @@
 #pragma once
 
 #include <cstdint>
+#include <cstdio>
 #include <string>
 
 #include <nlohmann/json.hpp>
@@ -28,5 +29,9 @@ struct Stats {
 void write_stats(const Stats& stats, const std::string& path);
 
 std::string human_bytes(std::uint64_t bytes);
+
+// Where the one-line human summary goes: stderr when --stats writes JSON to stdout ("-"),
+// so that stdout stays parseable; stdout otherwise.
+std::FILE* summary_stream(const std::string& stats_path);
 
 }  // namespace levelset::cli

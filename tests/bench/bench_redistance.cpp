@@ -89,18 +89,26 @@ double gradient_error(double h, const std::function<void(const std::function<voi
 }
 
 double ours_gradient_error(const NarrowBand& band) {
-  BandAccessor acc(band);
-  return gradient_error(
-      band.voxel_size(), [&](const auto& f) { band.for_each_active(f); },
-      [&](const Coord& c, float& v) {
-        const auto p = acc.probe(c);
-        if (p) v = *p;
-        return p.has_value();
-      });
+  return gradient_error(band.voxel_size(), [&](const auto& f) { band.for_each_active(f); }, band_probe(band));
+}
+
+auto vdb_probe(const openvdb::FloatGrid& grid) {
+  return [acc = grid.getConstAccessor()](const Coord& c, float& v) mutable {
+    const openvdb::Coord oc(c.x, c.y, c.z);
+    v = acc.getValue(oc);
+    return acc.isValueOn(oc);
+  };
+}
+
+auto band_probe(const NarrowBand& band) {
+  return [acc = BandAccessor(band)](const Coord& c, float& v) mutable {
+    const auto p = acc.probe(c);
+    if (p) v = *p;
+    return p.has_value();
+  };
 }
 
 double vdb_gradient_error(const openvdb::FloatGrid& grid) {
-  auto acc = grid.getConstAccessor();
   return gradient_error(
       grid.voxelSize()[0],
       [&](const auto& f) {
@@ -109,11 +117,28 @@ double vdb_gradient_error(const openvdb::FloatGrid& grid) {
           f(Coord{c.x(), c.y(), c.z()}, *it);
         }
       },
-      [&](const Coord& c, float& v) {
-        const openvdb::Coord oc(c.x, c.y, c.z);
-        v = acc.getValue(oc);
-        return acc.isValueOn(oc);
-      });
+      vdb_probe(grid));
+}
+
+// Largest displacement (in voxels) of the zero crossing, by linear interpolation, along the
+// input's sign-change edges whose two ends the result holds.
+template <typename Probe>
+double crossing_shift(const NarrowBand& in, Probe probe) {
+  BandAccessor acc(in);
+  double worst = 0;
+  in.for_each_active([&](const Coord& c, float u) {
+    for (int a = 0; a < 3; ++a) {
+      Coord e = c;
+      e[a] += 1;
+      const auto ue = acc.probe(e);
+      float dc, de;
+      if (!ue || (*ue < 0) == (u < 0) || !probe(c, dc) || !probe(e, de)) continue;
+      const double before = double(u) / (double(u) - double(*ue));
+      const double after = double(dc) / (double(dc) - double(de));
+      worst = std::max(worst, std::abs(after - before));
+    }
+  });
+  return worst;
 }
 
 // Voxels of `in` whose sign the result lost or flipped (the result must keep every one).

@@ -156,6 +156,20 @@ void expect_signs_and_invariant(const NarrowBand& out, const AnalyticShape& shap
   EXPECT_EQ(broken, 0u);
 }
 
+// The output band is the requested one: no value beyond W*h, and every voxel of the exact
+// band (same frame) with |d| <= (W - 0.05) h is active.
+void expect_band_extent(const NarrowBand& out, const NarrowBand& exact) {
+  const double h = out.voxel_size(), W = out.half_width();
+  std::size_t beyond = 0, missing = 0;
+  out.for_each_active([&](const Coord&, float v) { beyond += std::abs(double(v)) > W * h; });
+  BandAccessor acc(out);
+  exact.for_each_active([&](const Coord& c, float v) {
+    missing += std::abs(double(v)) <= (W - 0.05) * h && !acc.is_active(c);
+  });
+  EXPECT_EQ(beyond, 0u);
+  EXPECT_EQ(missing, 0u);
+}
+
 class RedistanceShapes : public ::testing::TestWithParam<RedistanceMethod> {};
 
 TEST_P(RedistanceShapes, DistortedSphere) {
@@ -174,6 +188,7 @@ TEST_P(RedistanceShapes, DistortedSphere) {
   EXPECT_LT(q.grad_error, 0.002);
   EXPECT_LT(q.grad_error_interface, 0.005);
   expect_signs_and_invariant(r.band, *sb.shape, sb.band, 6);
+  expect_band_extent(r.band, sb.band);
 }
 
 TEST_P(RedistanceShapes, DistortedTorus) {
@@ -186,6 +201,7 @@ TEST_P(RedistanceShapes, DistortedTorus) {
   EXPECT_LT(q.grad_error, 1e-2);
   EXPECT_LT(q.crossing_shift, 0.05);
   expect_signs_and_invariant(r.band, *sb.shape, sb.band, 4);
+  expect_band_extent(r.band, sb.band);
 }
 
 TEST_P(RedistanceShapes, DistortedKnot) {
@@ -198,6 +214,7 @@ TEST_P(RedistanceShapes, DistortedKnot) {
   EXPECT_LT(q.grad_error, 1e-2);
   EXPECT_LT(q.crossing_shift, 0.05);
   expect_signs_and_invariant(r.band, *sb.shape, sb.band, 2);
+  expect_band_extent(r.band, sb.band);
 }
 
 INSTANTIATE_TEST_SUITE_P(Redistance, RedistanceShapes,
@@ -259,6 +276,7 @@ TEST_P(RedistanceShapes, GrowingMatchesBuildingWide) {
   EXPECT_LT(q.value_error, 0.05);
   EXPECT_LT(q.grad_error, 1e-2);
   expect_signs_and_invariant(grown.band, *shape, wide.band, 3);
+  expect_band_extent(grown.band, wide.band);
 }
 
 TEST_P(RedistanceShapes, ShrinkingKeepsTheInnerBand) {
