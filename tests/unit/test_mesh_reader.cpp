@@ -16,6 +16,7 @@
 
 #include "core/error.hpp"
 #include "io/mesh_reader.hpp"
+#include "reader_test_support.hpp"
 
 namespace levelset {
 namespace {
@@ -27,42 +28,18 @@ MeshReadResult read(std::string_view bytes, std::string_view name,
   return read_mesh_from_memory(bytes, name, options);
 }
 
+using test::Bytes;
+
 // Succeeds when reading fails with exactly this code and where.
 ::testing::AssertionResult fails_with(std::string_view bytes, std::string_view name, ErrorCode code,
                                       std::string_view where, const MeshReadOptions& options = {}) {
-  try {
-    const MeshReadResult r = read_mesh_from_memory(bytes, name, options);
-    return ::testing::AssertionFailure()
-           << "read succeeded (" << r.mesh.vertices.size() << " vertices, "
-           << r.mesh.triangles.size() << " triangles); expected " << to_string(code) << " at "
-           << where;
-  } catch (const Error& e) {
-    if (e.code() != code || e.where() != where || e.reason().empty())
-      return ::testing::AssertionFailure()
-             << "got '" << e.what() << "'; expected " << to_string(code) << " at " << where;
-    return ::testing::AssertionSuccess() << e.what();
-  }
+  return test::fails_with([&] { return read_mesh_from_memory(bytes, name, options); },
+                          [](const MeshReadResult& r) {
+                            return std::to_string(r.mesh.vertices.size()) + " vertices, " +
+                                   std::to_string(r.mesh.triangles.size()) + " triangles";
+                          },
+                          code, where);
 }
-
-// Little/big-endian binary builder for PLY and STL inputs.
-struct Bytes {
-  std::string s;
-  bool big = false;
-
-  Bytes& text(std::string_view t) {
-    s += t;
-    return *this;
-  }
-  template <typename T>
-  Bytes& put(T value) {
-    char raw[sizeof(T)];
-    std::memcpy(raw, &value, sizeof(T));
-    if (big == (std::endian::native == std::endian::little))
-      for (std::size_t i = 0; i < sizeof(T) / 2; ++i) std::swap(raw[i], raw[sizeof(T) - 1 - i]);
-    s.append(raw, sizeof(T));
-    return *this;
-  }
-};
 
 const std::string kCubeOff =
     "OFF\n"                                                     // 1

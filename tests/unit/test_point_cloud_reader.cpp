@@ -13,6 +13,7 @@
 
 #include "core/error.hpp"
 #include "io/point_cloud_reader.hpp"
+#include "reader_test_support.hpp"
 
 namespace levelset {
 namespace {
@@ -22,39 +23,17 @@ PointCloudReadResult read(std::string_view bytes, std::string_view name,
   return read_point_cloud_from_memory(bytes, name, options);
 }
 
+using test::Bytes;
+
 ::testing::AssertionResult fails_with(std::string_view bytes, std::string_view name, ErrorCode code,
                                       std::string_view where,
                                       const PointCloudReadOptions& options = {}) {
-  try {
-    const PointCloudReadResult r = read_point_cloud_from_memory(bytes, name, options);
-    return ::testing::AssertionFailure()
-           << "read succeeded (" << r.cloud.points.size() << " points); expected "
-           << to_string(code) << " at " << where;
-  } catch (const Error& e) {
-    if (e.code() != code || e.where() != where || e.reason().empty())
-      return ::testing::AssertionFailure()
-             << "got '" << e.what() << "'; expected " << to_string(code) << " at " << where;
-    return ::testing::AssertionSuccess() << e.what();
-  }
+  return test::fails_with([&] { return read_point_cloud_from_memory(bytes, name, options); },
+                          [](const PointCloudReadResult& r) {
+                            return std::to_string(r.cloud.points.size()) + " points";
+                          },
+                          code, where);
 }
-
-struct Bytes {
-  std::string s;
-  bool big = false;
-  Bytes& text(std::string_view t) {
-    s += t;
-    return *this;
-  }
-  template <typename T>
-  Bytes& put(T value) {
-    char raw[sizeof(T)];
-    std::memcpy(raw, &value, sizeof(T));
-    if (big == (std::endian::native == std::endian::little))
-      for (std::size_t i = 0; i < sizeof(T) / 2; ++i) std::swap(raw[i], raw[sizeof(T) - 1 - i]);
-    s.append(raw, sizeof(T));
-    return *this;
-  }
-};
 
 TEST(PointCloudXyz, ReadsPointsOnly) {
   const PointCloudReadResult r =
