@@ -443,7 +443,6 @@ constexpr int flip_xor(int flip) { return ((flip & 1) ? 7 : 0) | ((flip & 2) ? 5
 // The 8 orderings, opposite directions in succession.
 constexpr int kOrderings[8] = {0, 7, 1, 6, 2, 5, 3, 4};
 
-
 // Copies the brick's distances and `Halo` layers of each face neighbour into a tile;
 // missing neighbours leave +inf. Signed: inside voxels negative (second-order stencils
 // need the sign to reach across the zero level).
@@ -551,7 +550,7 @@ void sweep_first(float* tile, const BrickMask& order_mask, int x, BrickMask& dir
 }
 
 // Second order on a signed tile: not monotone, so no min with the old value; dependents are
-// marked when a value moves by the tolerance or more.
+// marked when a value moves, by the tolerance or more.
 void sweep_second(float* tile, const BrickMask& order_mask, int x, float tolerance, BrickMask& dirty,
                   BrickSweep& s) {
   using G = TileGeom<2>;
@@ -581,7 +580,7 @@ void sweep_second(float* tile, const BrickMask& order_mask, int x, float toleran
       const float old = std::abs(cur);
       tile[t] = neg ? -mag : mag;
       const float change = mag < old ? old - mag : mag - old;  // NaN (inf - inf) compares false
-      if (!(change >= tolerance)) continue;
+      if (!(change > 0.0f && change >= tolerance)) continue;
       s.max_change = std::max(s.max_change, change);
       s.changed_faces |= kGeom2.faces[n];
       mark_dependents<2>(dirty, n);

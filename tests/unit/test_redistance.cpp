@@ -402,6 +402,32 @@ TEST(RedistanceMethods, SweepAndMarchAgree) {
   }
 }
 
+// The iteration cap and the tolerance: one iteration leaves work undone; tolerance 0 runs
+// to the exact fixed point, which the default tolerance (1e-6 h) matches closely.
+TEST(RedistanceSweep, IterationCapAndTolerance) {
+  const auto sb = make_shape_band("torus", 96);
+  const NarrowBand in = distort(sb.band);
+  RedistanceOptions o;
+  const RedistanceResult converged = redistance(in, o);
+  EXPECT_GE(converged.sweep_iterations, 2);
+  EXPECT_LE(converged.sweep_iterations, o.max_sweep_iterations);
+  o.max_sweep_iterations = 1;
+  const RedistanceResult capped = redistance(in, o);
+  EXPECT_EQ(capped.sweep_iterations, 1);
+  EXPECT_GT(compare(converged.band, capped.band).max_diff, 1e-3);
+  o.max_sweep_iterations = 8;
+  o.tolerance = 0.0;
+  for (int order : {1, 2}) {
+    o.order = order;
+    const RedistanceResult exact = redistance(in, o);
+    RedistanceOptions d;
+    d.order = order;
+    const BandDiff diff = compare(exact.band, redistance(in, d).band);
+    EXPECT_LT(diff.max_diff, 1e-4) << order;
+    EXPECT_EQ(diff.only_one, 0u) << order;
+  }
+}
+
 // A brick row with no band left after shrinking keeps a brick that carries its sign when
 // that sign differs from far_inside. With a valid input that cannot happen (far along x every
 // row has the far_inside sign), so this input is a prism infinite along x (cross-section y in
