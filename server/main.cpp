@@ -66,6 +66,9 @@ int main(int argc, char** argv) {
       ->check(CLI::IsMember({"sweep", "march"}));
   redist_cmd->add_option("--band,-b", redist.band, "New band half-width in voxels (default: keep)")
       ->check(CLI::Range(1.0, 64.0));
+  redist_cmd->add_option("--order", redist.order,
+                         "Upwind order: 1 (first-order Godunov, the thesis's) or 2 (second order)")
+      ->check(CLI::IsMember({1, 2}));
   redist_cmd->add_option("-o,--output", redist.output, "Output .lsg file")->required();
   add_common_options(redist_cmd, threads, redist.stats);
 

@@ -37,6 +37,7 @@ struct RedistanceArgs {
   std::string input;
   std::string method = "sweep";
   double band = 0.0;  // 0 = keep the input's half-width
+  int order = 2;      // 1: first-order Godunov update (the thesis's); 2: second order
   std::string output;
   std::string stats;
 };

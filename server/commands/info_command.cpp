@@ -46,6 +46,7 @@ json lsg_info(const std::string& path) {
   j["band_half_width_voxels"] = band.half_width();
   j["band_half_width"] = band.background();
   j["far_inside"] = band.far_inside();
+  j["closest_points"] = r.header.closest_points;
   j["bricks"] = band.brick_count();
   j["active_voxels"] = band.active_voxel_count();
   j["memory_bytes"] = band.memory_bytes();
@@ -103,6 +104,7 @@ void print_human(const std::string& path, const json& j) {
     std::printf("memory:          %s (%.2f B per active voxel)\n",
                 human_bytes(j["memory_bytes"]).c_str(), j["bytes_per_active_voxel"].get<double>());
     std::printf("file size:       %s\n", human_bytes(j["file_bytes"]).c_str());
+    if (j["closest_points"].get<bool>()) std::printf("fields:          closest surface point per voxel\n");
   } else if (kind == "mesh") {
     std::printf("kind:            triangle mesh (%s)\n", j["format"].get<std::string>().c_str());
     std::printf("vertices:        %llu\n", j["vertices"].get<unsigned long long>());

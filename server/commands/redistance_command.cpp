@@ -18,6 +18,7 @@ int run_redistance(const RedistanceArgs& args) {
   RedistanceOptions options;
   options.method = args.method == "march" ? RedistanceMethod::March : RedistanceMethod::Sweep;
   options.half_width = args.band;
+  options.order = args.order;
   const RedistanceResult result = redistance(in.band, options);
   const auto t2 = std::chrono::steady_clock::now();
   const LsgWriteResult written = save_lsg(result.band, args.output);
@@ -37,6 +38,7 @@ int run_redistance(const RedistanceArgs& args) {
   stats.active_voxels = result.band.active_voxel_count();
   stats.bytes = result.band.memory_bytes();
   stats.extra["method"] = args.method;
+  stats.extra["order"] = args.order;
   stats.extra["input_active_voxels"] = in.band.active_voxel_count();
   stats.extra["band_half_width"] = result.band.half_width();
   stats.extra["interface_voxels"] = result.interface_voxels;

@@ -51,6 +51,7 @@ pass
 import json, sys
 i, s = json.load(open(sys.argv[1])), json.load(open(sys.argv[2]))
 assert i["kind"] == "narrow_band" and i["active_voxels"] == s["active_voxels"], (i, s)
+assert i["closest_points"] is True, i
 PY
 pass
 
@@ -109,6 +110,7 @@ expect_error "empty mesh" "no" "$bin" cpt "$dir/empty.off" -r 32 -o "$dir/x.lsg"
 expect_error "voxel budget" "voxel budget" "$bin" cpt "$dir/box.off" --voxel-size 1e-7 -o "$dir/x.lsg"
 expect_error "both resolution and voxel size" "usage" "$bin" cpt "$dir/box.off" -r 32 --voxel-size 0.1 -o "$dir/x.lsg"
 expect_error "bad method" "usage" "$bin" redistance "$dir/box.lsg" --method magic -o "$dir/x.lsg"
+expect_error "bad order" "usage" "$bin" redistance "$dir/box.lsg" --order 3 -o "$dir/x.lsg"
 printf '1 2\n' > "$dir/bad.xyz"
 expect_error "bad points" "parse_error" "$bin" sample "$dir/box.lsg" --points "$dir/bad.xyz"
 [ ! -e "$dir/x.lsg" ] || fail "a failed command left an output file"
