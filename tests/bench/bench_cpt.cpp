@@ -4,10 +4,8 @@
 // Usage: bench_cpt [--quick]   (--quick: knot.off at R = 64 only, for the ctest smoke run)
 // Exit code 1 if a mesh is missing in the full run or the two sides disagree grossly on the
 // band (active voxel counts more than 5% apart: OpenVDB's band is not exact, ours is).
-#include <chrono>
 #include <cmath>
 #include <cstdio>
-#include <cstring>
 #include <filesystem>
 #include <string>
 #include <vector>
@@ -16,7 +14,7 @@
 #include <openvdb/tools/MeshToVolume.h>
 #include <tbb/global_control.h>
 
-#include "core/error.hpp"
+#include "bench_support.hpp"
 #include "distance/closest_point_transform.hpp"
 #include "grid/build_from_sdf.hpp"
 #include "io/mesh_reader.hpp"
@@ -24,25 +22,10 @@
 namespace {
 
 using namespace levelset;
-using Clock = std::chrono::steady_clock;
-
-template <typename F>
-double best_of(int runs, F&& f) {
-  double best = 1e300;
-  for (int i = 0; i < runs; ++i) {
-    const auto t0 = Clock::now();
-    f();
-    best = std::min(best, std::chrono::duration<double>(Clock::now() - t0).count());
-  }
-  return best;
-}
 
 bool bench_mesh(const std::string& path, const std::vector<int>& resolutions, int runs) {
   const TriangleMesh mesh = read_mesh(path).mesh;
-  std::vector<openvdb::Vec3s> points;
-  std::vector<openvdb::Vec3I> tris;
-  for (const auto& v : mesh.vertices) points.emplace_back(float(v.x), float(v.y), float(v.z));
-  for (const auto& t : mesh.triangles) tris.emplace_back(t[0], t[1], t[2]);
+  const bench::VdbMesh vdb_input = bench::vdb_mesh(mesh);
   bool ok = true;
   for (int res : resolutions) {
     for (int threads : {1, 2}) {
@@ -50,12 +33,13 @@ bool bench_mesh(const std::string& path, const std::vector<int>& resolutions, in
       CptOptions options;
       options.frame = frame_for_resolution(mesh.bounds(), res, 3.0);
       std::uint64_t ours_active = 0, vdb_active = 0;
-      const double ours = best_of(runs, [&] {
+      const double ours = bench::best_of(runs, [&] {
         ours_active = closest_point_transform(mesh, options).band.active_voxel_count();
       });
       auto xf = openvdb::math::Transform::createLinearTransform(options.frame.voxel_size);
-      const double vdb = best_of(runs, [&] {
-        vdb_active = openvdb::tools::meshToLevelSet<openvdb::FloatGrid>(*xf, points, tris, 3.0f)
+      const double vdb = bench::best_of(runs, [&] {
+        vdb_active = openvdb::tools::meshToLevelSet<openvdb::FloatGrid>(*xf, vdb_input.points,
+                                                                        vdb_input.triangles, 3.0f)
                          ->activeVoxelCount();
       });
       std::printf("%-14s %5d %3d %9.3f %9.3f %7.3fx %10llu %10llu  %s\n",
@@ -73,15 +57,15 @@ bool bench_mesh(const std::string& path, const std::vector<int>& resolutions, in
 }  // namespace
 
 int main(int argc, char** argv) {
-  const bool quick = argc > 1 && std::strcmp(argv[1], "--quick") == 0;
+  const bool quick = bench::is_quick(argc, argv);
   openvdb::initialize();
   const std::string data = std::string(LEVELSET_CGAL_DATA) + "/meshes/";
   std::printf("bench_cpt: closest point transform vs OpenVDB %s meshToLevelSet, W = 3, best of %d\n",
               openvdb::getLibraryAbiVersionString(), quick ? 1 : 3);
   std::printf("%-14s %5s %3s %9s %9s %8s %10s %10s\n", "mesh", "R", "thr", "ours_s", "vdb_s",
               "ratio", "our_active", "vdb_active");
-  bool ok = true;
-  try {
+  return bench::run_bench("bench_cpt", nullptr, [&] {
+    bool ok = true;
     for (const char* name : {"knot.off", "bunny00.off"}) {
       const std::string path = data + name;
       if (!std::filesystem::exists(path)) {
@@ -92,9 +76,6 @@ int main(int argc, char** argv) {
       ok &= bench_mesh(path, quick ? std::vector<int>{64} : std::vector<int>{256, 512}, quick ? 1 : 3);
       if (quick) break;
     }
-  } catch (const Error& e) {
-    std::fprintf(stderr, "bench_cpt: %s\n", e.what());
-    return 1;
-  }
-  return ok ? 0 : 1;
+    return ok;
+  });
 }

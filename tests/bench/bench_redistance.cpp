@@ -25,10 +25,8 @@
 // Exit code 1 if one of our results fails a sanity bound (gradient error, crossing shift,
 // signs).
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <cstdio>
-#include <cstring>
 #include <functional>
 #include <string>
 #include <vector>
@@ -37,10 +35,9 @@
 #include <openvdb/tools/FastSweeping.h>
 #include <openvdb/tools/LevelSetRebuild.h>
 #include <openvdb/tools/LevelSetTracker.h>
-#include <openvdb/tools/SignedFloodFill.h>
 #include <tbb/task_arena.h>
 
-#include "core/error.hpp"
+#include "bench_support.hpp"
 #include "distance/redistance.hpp"
 #include "geometry/analytic_shapes.hpp"
 #include "grid/band_accessor.hpp"
@@ -59,17 +56,6 @@ NarrowBand distort(const NarrowBand& band) {
     out.update_active_in_brick(b, [&](int n, float v) { return float(double(v) * wobble(out.world(o + local_coord(n)))); });
   });
   return out;
-}
-
-// Same index space (origin 0 in OpenVDB's transform = our origin), so leaves = bricks.
-openvdb::FloatGrid::Ptr vdb_from_band(const NarrowBand& band) {
-  auto grid = openvdb::FloatGrid::create(band.background());
-  grid->setTransform(openvdb::math::Transform::createLinearTransform(band.voxel_size()));
-  grid->setGridClass(openvdb::GRID_LEVEL_SET);
-  auto acc = grid->getAccessor();
-  band.for_each_active([&](const Coord& c, float v) { acc.setValueOn(openvdb::Coord(c.x, c.y, c.z), v); });
-  openvdb::tools::signedFloodFill(grid->tree());
-  return grid;
 }
 
 // probe(c, v): the value at voxel c if the result holds it active.
@@ -159,17 +145,6 @@ std::uint64_t sign_errors_vdb(const NarrowBand& in, const openvdb::FloatGrid& gr
   return bad;
 }
 
-template <typename F>
-double best_seconds(int runs, F&& f) {
-  double best = 1e30;
-  for (int i = 0; i < runs; ++i) {
-    const auto t0 = std::chrono::steady_clock::now();
-    f();
-    best = std::min(best, std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
-  }
-  return best;
-}
-
 struct Quality {
   bool measured = false;       // only for the 1-thread run
   double grad_error = 0;       // max ||grad d| - 1|
@@ -204,7 +179,7 @@ bool run_case(int res, int runs) {
   for (int threads : {1, 2}) {
     tbb::task_arena arena(threads);
     arena.execute([&] {
-      const auto grid = vdb_from_band(in);
+      const auto grid = bench::vdb_from_band(in);
       openvdb::FloatGrid::Ptr out;
       auto quality = [&](bool measure) {
         Quality q;
@@ -215,17 +190,17 @@ bool run_case(int res, int runs) {
         q.sign_errors = sign_errors_vdb(in, *out);
         return q;
       };
-      const double t = best_seconds(runs, [&] { out = openvdb::tools::sdfToSdf(*grid, 0.0f, 1); });
+      const double t = bench::best_of(runs, [&] { out = openvdb::tools::sdfToSdf(*grid, 0.0f, 1); });
       vdb_sweep_seconds[threads] = t;
       row("openvdb sdfToSdf", res, threads, voxels, t, 0, quality(threads == 1), "FastSweeping, 1 iteration");
-      const double tr = best_seconds(runs, [&] { out = openvdb::tools::levelSetRebuild(*grid, 0.0f, 3.0f); });
+      const double tr = bench::best_of(runs, [&] { out = openvdb::tools::levelSetRebuild(*grid, 0.0f, 3.0f); });
       row("openvdb levelSetRebuild", res, threads, voxels, tr, 0, quality(threads == 1),
           "mesh + rescan, " + std::to_string(out->activeVoxelCount()) + " active");
       double tn = 1e30;
       for (int i = 0; i < runs; ++i) {
         out = grid->deepCopy();
         openvdb::tools::LevelSetTracker<openvdb::FloatGrid> tracker(*out);
-        tn = std::min(tn, best_seconds(1, [&] { tracker.normalize(); }));
+        tn = std::min(tn, bench::best_of(1, [&] { tracker.normalize(); }));
       }
       row("openvdb normalize()", res, threads, voxels, tn, 0, quality(threads == 1), "3 HJWENO5 steps");
     });
@@ -241,7 +216,7 @@ bool run_case(int res, int runs) {
         RedistanceOptions o;
         o.method = method;
         o.order = order;
-        const double t = arena.execute([&] { return best_seconds(runs, [&] { r = redistance(in, o); }); });
+        const double t = arena.execute([&] { return bench::best_of(runs, [&] { r = redistance(in, o); }); });
         Quality q;
         if (threads == 1) {
           q.measured = true;
@@ -267,23 +242,16 @@ bool run_case(int res, int runs) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  const bool quick = argc > 1 && std::strcmp(argv[1], "--quick") == 0;
+  const bool quick = bench::is_quick(argc, argv);
   openvdb::initialize();
   const std::vector<int> res = quick ? std::vector<int>{128} : std::vector<int>{256, 512};
   std::printf("bench_redistance: distorted torus knot, W = 3, OpenVDB %s; seconds = best of %d\n",
               openvdb::getLibraryAbiVersionString(), quick ? 1 : 3);
   std::printf("%-24s %4s %3s %9s %8s %7s %9s %9s %9s %6s\n", "method", "R", "thr", "voxels", "seconds", "Mvox/s",
               "vs VDB sw", "|grad|-1", "x-shift", "signs");
-  bool ok = true;
-  try {
+  return bench::run_bench("bench_redistance", "a result failed its sanity bound", [&] {
+    bool ok = true;
     for (int r : res) ok &= run_case(r, quick ? 1 : 3);
-  } catch (const Error& e) {
-    std::fprintf(stderr, "bench_redistance: %s\n", e.what());
-    return 1;
-  }
-  if (!ok) {
-    std::fprintf(stderr, "bench_redistance: a result failed its sanity bound\n");
-    return 1;
-  }
-  return 0;
+    return ok;
+  });
 }

@@ -1,0 +1,41 @@
+// Dense tile geometry for redistance()'s per-brick kernels: a brick plus a halo of `Halo`
+// voxels (1 for the interface set-up and the first-order sweep, 2 for the second-order
+// sweep), laid out like grid/tile.hpp (x fastest, tile index of local voxel (x,y,z) =
+// (x+Halo) + dim*((y+Halo) + dim*(z+Halo)), dim = 8 + 2*Halo).
+//
+// TileGeom<Halo>: compile-time strides and index, plus per-voxel tables: tile_of[n] = the
+//   tile index of local voxel n, faces[n] bit f = n lies within Halo voxels of face f (Face
+//   order: -x, +x, -y, +y, -z, +z).
+// Cost: tables built at compile time (kGeom1, kGeom2). Threading: constant data.
+#pragma once
+
+#include <array>
+#include <cstdint>
+
+#include "grid/coord.hpp"
+
+namespace levelset::detail {
+
+template <int Halo>
+struct TileGeom {
+  static constexpr int kDim = kBrickDim + 2 * Halo;
+  static constexpr int kVoxels = kDim * kDim * kDim;
+  static constexpr int kStride[3] = {1, kDim, kDim * kDim};
+  static constexpr int index(int x, int y, int z) { return (x + Halo) + kDim * ((y + Halo) + kDim * (z + Halo)); }
+  std::array<std::uint16_t, kBrickVoxels> tile_of{};
+  std::array<std::uint8_t, kBrickVoxels> faces{};  // bit f: within Halo voxels of face f
+  constexpr TileGeom() {
+    for (int n = 0; n < kBrickVoxels; ++n) {
+      const int c[3] = {n & 7, (n >> 3) & 7, n >> 6};
+      tile_of[n] = std::uint16_t(index(c[0], c[1], c[2]));
+      for (int a = 0; a < 3; ++a) {
+        if (c[a] < Halo) faces[n] |= std::uint8_t(1u << (2 * a));
+        if (c[a] >= kBrickDim - Halo) faces[n] |= std::uint8_t(1u << (2 * a + 1));
+      }
+    }
+  }
+};
+inline constexpr TileGeom<1> kGeom1{};
+inline constexpr TileGeom<2> kGeom2{};
+
+}  // namespace levelset::detail

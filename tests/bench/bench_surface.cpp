@@ -1,0 +1,80 @@
+// bench_surface: our marching cubes and surface nets against OpenVDB's volumeToMesh
+// (isovalue 0, adaptivity 0) on the same band: the CPT band of CGAL's knot.off and
+// bunny00.off at R = 256 and 512 (W = 3), copied into an OpenVDB grid voxel for voxel.
+// Prints times (best of 3), the ratio ours / OpenVDB (target < 1) and triangle counts
+// (OpenVDB's quads count as two triangles), with 1 and 2 threads.
+// Usage: bench_surface [--quick]   (--quick: knot.off at R = 64, one run, for ctest)
+#include <cstdio>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include <openvdb/tools/VolumeToMesh.h>
+#include <tbb/global_control.h>
+
+#include "bench_support.hpp"
+#include "distance/closest_point_transform.hpp"
+#include "grid/build_from_sdf.hpp"
+#include "io/mesh_reader.hpp"
+#include "surface/marching_cubes.hpp"
+#include "surface/surface_nets.hpp"
+
+namespace {
+
+using namespace levelset;
+using levelset::bench::best_of;
+
+bool bench_mesh(const std::string& path, const std::vector<int>& resolutions, int runs) {
+  const TriangleMesh input = read_mesh(path).mesh;
+  bool ok = true;
+  for (int res : resolutions) {
+    CptOptions options;
+    options.frame = frame_for_resolution(input.bounds(), res, 3.0);
+    const NarrowBand band = closest_point_transform(input, options).band;
+    const auto grid = bench::vdb_from_band(band);  // same voxels and values, same index space
+    for (int threads : {1, 2}) {
+      tbb::global_control limit(tbb::global_control::max_allowed_parallelism, threads);
+      std::size_t mc_tris = 0, sn_tris = 0, vdb_tris = 0;
+      const double mc = best_of(runs, [&] { mc_tris = marching_cubes(band).mesh.triangles.size(); });
+      const double sn = best_of(runs, [&] { sn_tris = surface_nets(band).mesh.triangles.size(); });
+      const double vdb = best_of(runs, [&] {
+        std::vector<openvdb::Vec3s> points;
+        std::vector<openvdb::Vec3I> tris;
+        std::vector<openvdb::Vec4I> quads;
+        openvdb::tools::volumeToMesh(*grid, points, tris, quads, 0.0, 0.0);
+        vdb_tris = tris.size() + 2 * quads.size();
+      });
+      const std::string name = std::filesystem::path(path).filename().string();
+      std::printf("%-12s %4d %3d %8.3f %8.3f %8.3f %7.3fx %7.3fx %9zu %9zu %9zu\n", name.c_str(), res,
+                  threads, mc, sn, vdb, mc / vdb, sn / vdb, mc_tris, sn_tris, vdb_tris);
+      std::fflush(stdout);
+      ok &= mc_tris > 0 && sn_tris > 0 && vdb_tris > 0;
+    }
+  }
+  return ok;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  const bool quick = bench::is_quick(argc, argv);
+  openvdb::initialize();
+  std::printf("bench_surface: extraction vs OpenVDB %s volumeToMesh (iso 0, adaptivity 0), best of %d\n",
+              openvdb::getLibraryAbiVersionString(), quick ? 1 : 3);
+  std::printf("%-12s %4s %3s %8s %8s %8s %8s %8s %9s %9s %9s\n", "mesh", "R", "thr", "mc_s", "nets_s",
+              "vdb_s", "mc/vdb", "nets/vdb", "mc_tris", "nets_tris", "vdb_tris");
+  return bench::run_bench("bench_surface", "an extractor produced no triangles", [&] {
+    bool ok = true;
+    for (const char* name : {"knot.off", "bunny00.off"}) {
+      const std::string path = std::string(LEVELSET_CGAL_DATA) + "/meshes/" + name;
+      if (!std::filesystem::exists(path)) {
+        std::printf("%-12s missing: %s (run deploy/install-deps.sh)\n", name, path.c_str());
+        if (!quick) ok = false;
+        continue;
+      }
+      ok &= bench_mesh(path, quick ? std::vector<int>{64} : std::vector<int>{256, 512}, quick ? 1 : 3);
+      if (quick) break;
+    }
+    return ok;
+  });
+}
