@@ -78,6 +78,23 @@ int main(int argc, char** argv) {
   sample_cmd->add_option("--points", sample.points, "Points (.xyz .xyzn .pwn .ply)")->required();
   sample_cmd->add_option("-o,--output", sample.output, "Output text file, one value per line (default: stdout)");
 
+  levelset::cli::MeshArgs mesh;
+  CLI::App* mesh_cmd = app.add_subcommand("mesh", "Extract the iso-surface as a triangle mesh");
+  mesh_cmd->add_option("input", mesh.input, "Input .lsg")->required();
+  mesh_cmd->add_option("-o,--output", mesh.output, "Output mesh (.ply .obj .off .stl)")->required();
+  mesh_cmd->add_option("--iso", mesh.iso, "Iso value (inside the band)");
+  mesh_cmd->add_option("--method", mesh.method, "mc (marching cubes) or nets (surface nets)")
+      ->check(CLI::IsMember({"mc", "nets"}));
+  add_common_options(mesh_cmd, threads, mesh.stats);
+
+  levelset::cli::MeasureArgs measure;
+  CLI::App* measure_cmd = app.add_subcommand("measure", "Area, volume, components and genus of the surface");
+  measure_cmd->add_option("input", measure.input, "Input .lsg")->required();
+  measure_cmd->add_option("--iso", measure.iso, "Iso value (inside the band)");
+  measure_cmd->add_option("--method", measure.method, "mc (marching cubes) or nets (surface nets)")
+      ->check(CLI::IsMember({"mc", "nets"}));
+  measure_cmd->add_flag("--json", measure.json, "Print JSON instead of text");
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -95,6 +112,8 @@ int main(int argc, char** argv) {
     if (*cpt_cmd) return levelset::cli::run_cpt(cpt);
     if (*redist_cmd) return levelset::cli::run_redistance(redist);
     if (*sample_cmd) return levelset::cli::run_sample(sample);
+    if (*mesh_cmd) return levelset::cli::run_mesh(mesh);
+    if (*measure_cmd) return levelset::cli::run_measure(measure);
   } catch (const levelset::Error& e) {
     std::fprintf(stderr, "levelsetd: %s\n", e.what());
     return 1;

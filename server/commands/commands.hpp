@@ -5,6 +5,9 @@
 
 #include <string>
 
+#include "grid/narrow_band.hpp"
+#include "surface/surface_result.hpp"
+
 namespace levelset::cli {
 
 struct InfoArgs {
@@ -49,5 +52,25 @@ struct SampleArgs {
   std::string output;
 };
 int run_sample(const SampleArgs& args);
+
+struct MeshArgs {
+  std::string input;
+  std::string output;
+  std::string method = "mc";
+  double iso = 0.0;
+  std::string stats;
+};
+int run_mesh(const MeshArgs& args);
+
+struct MeasureArgs {
+  std::string input;
+  std::string method = "mc";
+  double iso = 0.0;
+  bool json = false;
+};
+int run_measure(const MeasureArgs& args);
+
+// The surface of a band by marching cubes ("mc") or surface nets ("nets").
+SurfaceResult extract_surface(const NarrowBand& band, const std::string& method, double iso);
 
 }  // namespace levelset::cli

@@ -83,6 +83,25 @@ PY
   pass
 done
 
+# Surface of the box: area 10, volume 2 (marching cubes cuts the sharp edges a little).
+for method in mc nets; do
+  "$bin" measure "$dir/box.lsg" --method "$method" --json > "$dir/measure_$method.json" || fail "measure $method"
+  "$py" - "$dir/measure_$method.json" <<'PY' || fail "measure values"
+import json, sys
+m = json.load(open(sys.argv[1]))
+assert m["watertight"] and m["manifold"] and m["components"] == 1 and m["genus"] == 0, m
+assert abs(m["area"] - 10) < 0.2 and abs(m["volume"] - 2) < 0.04, m
+PY
+  "$bin" mesh "$dir/box.lsg" --method "$method" -o "$dir/box_$method.ply" > /dev/null || fail "mesh $method"
+  "$bin" info "$dir/box_$method.ply" --json > "$dir/mesh_$method.json" || fail "info of the mesh"
+  "$py" - "$dir/mesh_$method.json" "$dir/measure_$method.json" <<'PY' || fail "mesh file"
+import json, sys
+i, m = json.load(open(sys.argv[1])), json.load(open(sys.argv[2]))
+assert i["kind"] == "mesh" and i["triangles"] == m["triangles"] and i["vertices"] == m["vertices"], (i, m)
+PY
+  pass
+done
+
 if [ -f "$data/meshes/knot.off" ]; then
   "$bin" cpt "$data/meshes/knot.off" --resolution 96 --band 3 -o "$dir/knot.lsg" --threads 1 > /dev/null \
     || fail "cpt knot.off"
@@ -111,9 +130,11 @@ expect_error "voxel budget" "voxel budget" "$bin" cpt "$dir/box.off" --voxel-siz
 expect_error "both resolution and voxel size" "usage" "$bin" cpt "$dir/box.off" -r 32 --voxel-size 0.1 -o "$dir/x.lsg"
 expect_error "bad method" "usage" "$bin" redistance "$dir/box.lsg" --method magic -o "$dir/x.lsg"
 expect_error "bad order" "usage" "$bin" redistance "$dir/box.lsg" --order 3 -o "$dir/x.lsg"
+expect_error "iso outside the band" "iso" "$bin" mesh "$dir/box.lsg" --iso 5 -o "$dir/x.ply"
+expect_error "unknown mesh format" "unsupported_format" "$bin" mesh "$dir/box.lsg" -o "$dir/x.xyz"
 printf '1 2\n' > "$dir/bad.xyz"
 expect_error "bad points" "parse_error" "$bin" sample "$dir/box.lsg" --points "$dir/bad.xyz"
-[ ! -e "$dir/x.lsg" ] || fail "a failed command left an output file"
+[ ! -e "$dir/x.lsg" ] && [ ! -e "$dir/x.ply" ] && [ ! -e "$dir/x.xyz" ] || fail "a failed command left an output file"
 pass
 
 echo "cli_distance: $checks checks passed"

@@ -1,0 +1,100 @@
+#include "surface/cell_loops.hpp"
+
+#include <vector>
+
+namespace levelset::cell {
+
+std::array<int, 4> face_corners(int f) {
+  const int a = f >> 1, side = f & 1;
+  const int u = a == 0 ? 1 : 0, v = a == 2 ? 1 : 2;
+  const int base = side << a;
+  return {base, base | (1 << u), base | (1 << u) | (1 << v), base | (1 << v)};
+}
+
+namespace {
+
+int edge_between(int c0, int c1) {
+  for (int e = 0; e < 12; ++e) {
+    const int lo = edge_lower_corner(e), hi = edge_upper_corner(e);
+    if ((lo == c0 && hi == c1) || (lo == c1 && hi == c0)) return e;
+  }
+  return -1;
+}
+
+LoopSet trace(int m, int decisions) {
+  LoopSet s;
+  s.loop_of_edge.fill(0xff);
+  std::array<int, 12> next;
+  next.fill(-1);
+  // Which face holds both segments of a 4-crossing face: pairs of entry edges per face.
+  std::vector<std::array<int, 2>> doubled;
+  for (int f = 0; f < 6; ++f) {
+    std::array<int, 4> c = face_corners(f);
+    // Counter-clockwise seen from outside the cell. The canonical order turns about +axis for
+    // x and z (y x z = +x, x x y = +z) and about -axis for y (x x z = -y).
+    const bool about_plus = (f >> 1) != 1;
+    const bool outward_plus = (f & 1) == 1;
+    if (about_plus != outward_plus) c = {c[0], c[3], c[2], c[1]};
+    int edges[4];
+    bool in[4];
+    for (int i = 0; i < 4; ++i) {
+      edges[i] = edge_between(c[i], c[(i + 1) & 3]);
+      in[i] = (m >> c[i]) & 1;
+    }
+    int crossings = 0;
+    for (int i = 0; i < 4; ++i) crossings += in[i] != in[(i + 1) & 3];
+    if (crossings == 0) continue;
+    // Edge i is an entry when it goes outside -> inside; segments run entry -> exit.
+    if (crossings == 2) {
+      int entry = -1, exit = -1;
+      for (int i = 0; i < 4; ++i) {
+        if (!in[i] && in[(i + 1) & 3]) entry = edges[i];
+        if (in[i] && !in[(i + 1) & 3]) exit = edges[i];
+      }
+      next[entry] = exit;
+      continue;
+    }
+    const bool connected = (decisions >> f) & 1;
+    std::array<int, 2> pair{};
+    int k = 0;
+    for (int i = 0; i < 4; ++i) {
+      if (in[i] || !in[(i + 1) & 3]) continue;
+      next[edges[i]] = connected ? edges[(i + 3) & 3] : edges[(i + 1) & 3];
+      pair[k++] = edges[i];
+    }
+    doubled.push_back(pair);
+  }
+  int pos = 0;
+  for (int e0 = 0; e0 < 12; ++e0) {
+    if (next[e0] < 0 || s.loop_of_edge[e0] != 0xff) continue;
+    const int l = s.loop_count++;
+    s.begin[l] = std::uint8_t(pos);
+    int e = e0;
+    do {
+      s.loop_of_edge[e] = std::uint8_t(l);
+      s.edges[pos++] = std::uint8_t(e);
+      e = next[e];
+    } while (e != e0);
+    s.length[l] = std::uint8_t(pos - s.begin[l]);
+  }
+  for (const auto& p : doubled)
+    if (s.loop_of_edge[p[0]] == s.loop_of_edge[p[1]]) s.doubled_face_loops |= std::uint8_t(1u << s.loop_of_edge[p[0]]);
+  return s;
+}
+
+struct Table {
+  std::vector<LoopSet> sets;
+  Table() : sets(256 * 64) {
+    for (int m = 0; m < 256; ++m)
+      for (int d = 0; d < 64; ++d) sets[m * 64 + d] = trace(m, d);
+  }
+};
+
+}  // namespace
+
+const LoopSet& loops_for(int inside_mask, int face_decisions) {
+  static const Table table;
+  return table.sets[std::size_t(inside_mask) * 64 + std::size_t(face_decisions)];
+}
+
+}  // namespace levelset::cell

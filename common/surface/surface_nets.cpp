@@ -1,0 +1,196 @@
+#include "surface/surface_nets.hpp"
+
+#include <algorithm>
+#include <array>
+#include <chrono>
+#include <cmath>
+
+#include <tbb/enumerable_thread_specific.h>
+
+#include "core/error.hpp"
+#include "surface/cell_loops.hpp"
+#include "surface/cell_tile.hpp"
+#include "surface/surface_common.hpp"
+
+namespace levelset {
+
+using namespace surface_detail;
+
+namespace {
+
+constexpr int kLoopSlots = kBrickVoxels * 4;  // 2048
+constexpr int kSlotBits = 12;
+
+struct BrickOut {
+  std::vector<Vec3d> vertices;
+  std::vector<Vec3f> normals;
+  std::vector<std::array<std::uint64_t, 3>> triangles;  // owner << 12 | slot
+  SlotBits<kLoopSlots> owned;
+  std::uint64_t cells = 0;
+};
+
+const cell::LoopSet& cell_loops(const CellTile& t, int x, int y, int z, double iso) {
+  double a[8];
+  const int p0 = CellTile::index(x, y, z);
+  for (int i = 0; i < 8; ++i) a[i] = double(t.values[p0 + kCornerOffset[i]]) - iso;
+  int m, d;
+  cell::classify(a, m, d);
+  return cell::loops_for(m, d);
+}
+
+double trilinear(const CellTile& t, const Vec3d& c, int x, int y, int z, double iso) {
+  const double fx = c.x - x, fy = c.y - y, fz = c.z - z;
+  const int p0 = CellTile::index(x, y, z);
+  double v = 0.0;
+  for (int i = 0; i < 8; ++i) {
+    const double w = ((i & 1) ? fx : 1 - fx) * ((i & 2) ? fy : 1 - fy) * ((i & 4) ? fz : 1 - fz);
+    v += (double(t.values[p0 + kCornerOffset[i]]) - iso) * w;
+  }
+  return v;
+}
+
+// Local position of the vertex of loop l of cell (x,y,z).
+Vec3d loop_vertex(const CellTile& t, int x, int y, int z, const cell::LoopSet& ls, int l,
+                  double iso, int iterations) {
+  Vec3d c{};
+  const int n = ls.length[l];
+  for (int i = 0; i < n; ++i) {
+    const int e = ls.edges[ls.begin[l] + i];
+    const int k = cell::edge_lower_corner(e);
+    c += edge_point_position(t, x + (k & 1), y + ((k >> 1) & 1), z + ((k >> 2) & 1), e >> 2, iso);
+  }
+  c = c / double(n);
+  for (int it = 0; it < iterations; ++it) {
+    const double phi = trilinear(t, c, x, y, z, iso);
+    const Vec3d g = gradient_at(t, c, x, y, z);
+    const double gg = dot(g, g);
+    if (!(gg > 1e-12)) break;
+    c -= g * (phi / gg);
+    c = {std::clamp(c.x, double(x), double(x + 1)), std::clamp(c.y, double(y), double(y + 1)),
+         std::clamp(c.z, double(z), double(z + 1))};
+  }
+  return c;
+}
+
+void process_brick(const NarrowBand& band, std::uint32_t b, double iso, int iterations,
+                   CellTile& t, BrickOut& out) {
+  gather_cell_tile(band, b, t);
+  const Coord base = brick_origin(band.bricks()[b].coord);
+  const Vec3d bw{double(base.x), double(base.y), double(base.z)};
+  const double h = band.voxel_size();
+  const Vec3d org = band.origin();
+  ValidCells valid;
+  valid.compute(t);
+
+  // Owned cell-loop vertices in slot order.
+  for (int z = 0; z < kBrickDim; ++z)
+    for (int y = 0; y < kBrickDim; ++y)
+      for (int x = 0; x < kBrickDim; ++x) {
+        if (!valid.at(x, y, z)) continue;
+        const cell::LoopSet& ls = cell_loops(t, x, y, z, iso);
+        if (ls.loop_count == 0) continue;
+        ++out.cells;
+        for (int l = 0; l < ls.loop_count; ++l) {
+          const Vec3d c = loop_vertex(t, x, y, z, ls, l, iso, iterations);
+          out.owned.set(4 * local_index(x, y, z) + l);
+          out.vertices.push_back(org + (bw + c) * h);
+          out.normals.push_back(normalized_f(gradient_at(t, c, x, y, z)));
+        }
+      }
+
+  // Quads around owned crossing edges.
+  for (int z = 0; z < kBrickDim; ++z)
+    for (int y = 0; y < kBrickDim; ++y)
+      for (int x = 0; x < kBrickDim; ++x) {
+        const int p = CellTile::index(x, y, z);
+        if (!t.active[p]) continue;
+        const bool p_in = double(t.values[p]) - iso < 0.0;
+        for (int a = 0; a < 3; ++a) {
+          const int q = p + kTileStride[a];
+          if (!t.active[q]) continue;
+          if (p_in == (double(t.values[q]) - iso < 0.0)) continue;
+          const int bax = a == 0 ? 1 : 0, cax = a == 2 ? 1 : 2;
+          static constexpr int kOrder[4][2] = {{0, 0}, {1, 0}, {1, 1}, {0, 1}};
+          std::array<std::uint64_t, 4> key;
+          std::array<Vec3d, 4> pos;
+          bool ok = true;
+          for (int k = 0; k < 4 && ok; ++k) {
+            int c[3] = {x, y, z};
+            c[bax] -= kOrder[k][0];
+            c[cax] -= kOrder[k][1];
+            if (!valid.at(c[0], c[1], c[2])) { ok = false; break; }
+            const cell::LoopSet& ls = cell_loops(t, c[0], c[1], c[2], iso);
+            const int e = 4 * a + kOrder[k][0] + 2 * kOrder[k][1];
+            const int l = ls.loop_of_edge[e];
+            pos[k] = loop_vertex(t, c[0], c[1], c[2], ls, l, iso, iterations);
+            const int owner = CellTile::neighbor_slot(c[0] < 0 ? -1 : 0, c[1] < 0 ? -1 : 0, c[2] < 0 ? -1 : 0);
+            key[k] = (std::uint64_t(t.around[owner]) << kSlotBits) |
+                     std::uint64_t(4 * local_index(c[0] & 7, c[1] & 7, c[2] & 7) + l);
+          }
+          if (!ok) continue;
+          // kOrder turns about +a for x and z and about -a for y; outside lies at +a when p is in.
+          if ((a == 1) == p_in) {
+            std::swap(key[1], key[3]);
+            std::swap(pos[1], pos[3]);
+          }
+          const double d02 = std::max(max_cos(pos[0], pos[1], pos[2]), max_cos(pos[0], pos[2], pos[3]));
+          const double d13 = std::max(max_cos(pos[1], pos[2], pos[3]), max_cos(pos[1], pos[3], pos[0]));
+          if (d02 <= d13) {
+            out.triangles.push_back({key[0], key[1], key[2]});
+            out.triangles.push_back({key[0], key[2], key[3]});
+          } else {
+            out.triangles.push_back({key[1], key[2], key[3]});
+            out.triangles.push_back({key[1], key[3], key[0]});
+          }
+        }
+      }
+}
+
+}  // namespace
+
+SurfaceResult surface_nets(const NarrowBand& band, const SurfaceNetsOptions& options) {
+  const auto start = std::chrono::steady_clock::now();
+  check_iso(band, options.iso, "surface_nets");
+  if (options.relax_iterations < 0)
+    throw Error(ErrorCode::InvalidArgument, "surface_nets", "relax_iterations must be >= 0");
+  const std::uint32_t nb = std::uint32_t(band.brick_count());
+  std::vector<BrickOut> outs(nb);
+  tbb::enumerable_thread_specific<CellTile> tiles;
+  for_brick_batches(nb, options.progress, "surface_nets", [&](std::uint32_t b) {
+    process_brick(band, b, options.iso, options.relax_iterations, tiles.local(), outs[b]);
+  });
+  SurfaceResult r;
+  std::vector<std::uint32_t> offset(nb + 1, 0);
+  std::vector<std::uint64_t> tri_offset(nb + 1, 0);
+  std::uint64_t total = 0;
+  for (std::uint32_t b = 0; b < nb; ++b) {
+    offset[b] = std::uint32_t(total);
+    total += outs[b].vertices.size();
+    tri_offset[b + 1] = tri_offset[b] + outs[b].triangles.size();
+    outs[b].owned.finish();
+    r.cells_with_surface += outs[b].cells;
+  }
+  if (total >= 0xffffffffull) throw Error(ErrorCode::LimitExceeded, "surface_nets", "more than 2^32 - 1 vertices");
+  r.mesh.vertices.resize(total);
+  r.normals.resize(total);
+  r.mesh.triangles.resize(tri_offset[nb]);
+  auto remap = [&](std::uint64_t k) {
+    const std::uint32_t owner = std::uint32_t(k >> kSlotBits);
+    return offset[owner] + outs[owner].owned.rank(int(k & ((1u << kSlotBits) - 1)));
+  };
+  tbb::parallel_for(tbb::blocked_range<std::uint32_t>(0, nb, 64), [&](const tbb::blocked_range<std::uint32_t>& rg) {
+    for (std::uint32_t b = rg.begin(); b != rg.end(); ++b) {
+      const BrickOut& o = outs[b];
+      std::copy(o.vertices.begin(), o.vertices.end(), r.mesh.vertices.begin() + offset[b]);
+      std::copy(o.normals.begin(), o.normals.end(), r.normals.begin() + offset[b]);
+      for (std::size_t i = 0; i < o.triangles.size(); ++i) {
+        const auto& k = o.triangles[i];
+        r.mesh.triangles[tri_offset[b] + i] = {remap(k[0]), remap(k[1]), remap(k[2])};
+      }
+    }
+  });
+  r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return r;
+}
+
+}  // namespace levelset
