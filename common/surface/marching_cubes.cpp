@@ -40,20 +40,17 @@ void process_brick(const NarrowBand& band, std::uint32_t b, double iso, CellTile
   const double h = band.voxel_size();
   const Vec3d org = band.origin();
   ValidCells valid;
-  valid.compute(t);
+  valid.compute(t, iso);
 
   // Owned edge vertices.
   for (int z = 0; z < kBrickDim; ++z)
-    for (int y = 0; y < kBrickDim; ++y)
-      for (int x = 0; x < kBrickDim; ++x) {
-        const int p = CellTile::index(x, y, z);
-        if (!t.active[p]) continue;
-        const double ap = double(t.values[p]) - iso;
+    for (int y = 0; y < kBrickDim; ++y) {
+      std::uint32_t cr[3];
+      valid.crossing_edges(y, z, cr);
+      for (std::uint32_t bits = cr[0] | cr[1] | cr[2]; bits != 0; bits &= bits - 1) {
+        const int x = std::countr_zero(bits);
         for (int a = 0; a < 3; ++a) {
-          const int q = p + kTileStride[a];
-          if (!t.active[q]) continue;
-          const double aq = double(t.values[q]) - iso;
-          if ((ap < 0.0) == (aq < 0.0)) continue;
+          if (!((cr[a] >> x) & 1u)) continue;
           if (!valid.edge_used(x, y, z, a)) continue;
           out.owned.set(3 * local_index(x, y, z) + a);
           const EdgePoint e = edge_point(t, x, y, z, a, iso);
@@ -61,6 +58,7 @@ void process_brick(const NarrowBand& band, std::uint32_t b, double iso, CellTile
           out.normals.push_back(e.normal);
         }
       }
+    }
   out.edge_vertices = std::uint32_t(out.vertices.size());
 
   // Cells.
@@ -68,8 +66,8 @@ void process_brick(const NarrowBand& band, std::uint32_t b, double iso, CellTile
   std::array<std::uint64_t, 12> key;
   for (int z = 0; z < kBrickDim; ++z)
     for (int y = 0; y < kBrickDim; ++y)
-      for (int x = 0; x < kBrickDim; ++x) {
-        if (!valid.at(x, y, z)) continue;
+      for (std::uint32_t bits = (valid.mixed_row(y, z) >> ValidCells::kH) & 0xffu; bits != 0; bits &= bits - 1) {
+        const int x = std::countr_zero(bits);
         double a[8];
         const int p0 = CellTile::index(x, y, z);
         for (int i = 0; i < 8; ++i) a[i] = double(t.values[p0 + kCornerOffset[i]]) - iso;

@@ -29,15 +29,53 @@ struct ValidCells {
   std::array<std::uint8_t, kN * kN * kN> flags{};
   static int index(int x, int y, int z) { return (x + 1) + kN * ((y + 1) + kN * (z + 1)); }
   bool at(int x, int y, int z) const { return flags[index(x, y, z)] != 0; }
-  void compute(const CellTile& t) {
-    for (int z = -1; z < kBrickDim; ++z)
-      for (int y = -1; y < kBrickDim; ++y)
-        for (int x = -1; x < kBrickDim; ++x) {
-          const int p = CellTile::index(x, y, z);
-          std::uint8_t all = 1;
-          for (int i = 0; i < 8; ++i) all &= t.active[p + kCornerOffset[i]];
-          flags[index(x, y, z)] = all;
+  // Row bitmasks over x (bit x + kHalo) for every tile row (y, z): active and inside (< iso).
+  static constexpr int kH = CellTile::kHalo;
+  static int row(int y, int z) { return (y + kH) + CellTile::kDim * (z + kH); }
+  std::array<std::uint32_t, CellTile::kDim * CellTile::kDim> active_rows{}, inside_rows{};
+  // Per cell row (y, z) in [-1, 8)^2: valid cells and valid cells crossing iso (bit x + kHalo).
+  std::array<std::uint32_t, kN * kN> valid_rows{}, mixed_rows{};
+  void compute(const CellTile& t, double iso = 0.0) {
+    for (int z = -kH; z < kBrickDim + kH; ++z)
+      for (int y = -kH; y < kBrickDim + kH; ++y) {
+        const int p = CellTile::index(-kH, y, z);
+        std::uint32_t act = 0, ins = 0;
+        for (int x = 0; x < CellTile::kDim; ++x) {
+          act |= std::uint32_t(t.active[p + x] != 0) << x;
+          ins |= std::uint32_t(double(t.values[p + x]) < iso) << x;
         }
+        active_rows[row(y, z)] = act;
+        inside_rows[row(y, z)] = ins;
+      }
+    constexpr std::uint32_t kCellBits = ((1u << kN) - 1) << (kH - 1);  // x in [-1, 8)
+    for (int z = -1; z < kBrickDim; ++z)
+      for (int y = -1; y < kBrickDim; ++y) {
+        const int r = row(y, z);
+        constexpr int D = CellTile::kDim;
+        std::uint32_t v = active_rows[r] & active_rows[r + 1] & active_rows[r + D] & active_rows[r + D + 1];
+        v &= v >> 1;
+        v &= kCellBits;
+        const std::uint32_t i0 = inside_rows[r], i1 = inside_rows[r + 1], i2 = inside_rows[r + D],
+                            i3 = inside_rows[r + D + 1];
+        std::uint32_t o = i0 | i1 | i2 | i3, n = i0 & i1 & i2 & i3;
+        o |= o >> 1;
+        n &= n >> 1;
+        const int cr = (y + 1) + kN * (z + 1);
+        valid_rows[cr] = v;
+        mixed_rows[cr] = v & o & ~n;
+        for (int x = -1; x < kBrickDim; ++x) flags[index(x, y, z)] = std::uint8_t((v >> (x + kH)) & 1u);
+      }
+  }
+  std::uint32_t mixed_row(int y, int z) const { return mixed_rows[(y + 1) + kN * (z + 1)]; }
+  // Grid edges from (x, y, z), x in [0, 8), along axis a whose both ends are active and lie on
+  // opposite sides of iso: bit x of c[a].
+  void crossing_edges(int y, int z, std::uint32_t c[3]) const {
+    const int r = row(y, z);
+    const std::uint32_t act = active_rows[r], ins = inside_rows[r];
+    const int nb[3] = {0, r + 1, r + CellTile::kDim};
+    c[0] = act & (act >> 1) & (ins ^ (ins >> 1));
+    for (int a = 1; a < 3; ++a) c[a] = act & active_rows[nb[a]] & (ins ^ inside_rows[nb[a]]);
+    for (int a = 0; a < 3; ++a) c[a] = (c[a] >> kH) & 0xffu;
   }
   // Any of the 4 cells around the edge from (x,y,z) along axis a is valid.
   bool edge_used(int x, int y, int z, int a) const {
@@ -139,6 +177,13 @@ inline double max_cos(const Vec3d& a, const Vec3d& b, const Vec3d& c) {
 
 // Fan apex for a polygon of n >= 4 vertices that maximises the smallest angle.
 inline int best_fan_start(const Vec3d* p, int n) {
+  if (n == 4) {
+    // Fans at 2 and 3 repeat the triangles of fans 0 and 1 (max_cos is invariant under cyclic
+    // rotation), and ties keep the earliest start: same answer as the general loop.
+    const double w0 = std::max(max_cos(p[0], p[1], p[2]), max_cos(p[0], p[2], p[3]));
+    const double w1 = std::max(max_cos(p[1], p[2], p[3]), max_cos(p[1], p[3], p[0]));
+    return w1 < w0 ? 1 : 0;
+  }
   int best = 0;
   double best_cos = 2.0;
   for (int s = 0; s < n; ++s) {

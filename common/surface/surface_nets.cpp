@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <array>
+#include <bit>
 #include <chrono>
 #include <cmath>
 
@@ -38,20 +39,44 @@ const cell::LoopSet& cell_loops(const CellTile& t, int x, int y, int z, double i
   return cell::loops_for(m, d);
 }
 
-double trilinear(const CellTile& t, const Vec3d& c, int x, int y, int z, double iso) {
-  const double fx = c.x - x, fy = c.y - y, fz = c.z - z;
-  const int p0 = CellTile::index(x, y, z);
-  double v = 0.0;
-  for (int i = 0; i < 8; ++i) {
-    const double w = ((i & 1) ? fx : 1 - fx) * ((i & 2) ? fy : 1 - fy) * ((i & 4) ? fz : 1 - fz);
-    v += (double(t.values[p0 + kCornerOffset[i]]) - iso) * w;
+// The 8 corner values (minus iso) and corner central differences of one cell, gathered once
+// and reused by every Newton step and the normal (same arithmetic as gradient_at/trilinear).
+struct CellCorners {
+  double a[8];
+  Vec3d g[8];
+  CellCorners(const CellTile& t, int x, int y, int z, double iso) {
+    const int p0 = CellTile::index(x, y, z);
+    for (int i = 0; i < 8; ++i) {
+      a[i] = double(t.values[p0 + kCornerOffset[i]]) - iso;
+      g[i] = corner_gradient(t, p0 + kCornerOffset[i]);
+    }
   }
-  return v;
-}
+  void eval(const Vec3d& c, int x, int y, int z, double& phi, Vec3d& grad) const {
+    const double fx = c.x - x, fy = c.y - y, fz = c.z - z;
+    double v = 0.0;
+    Vec3d gg{};
+    for (int i = 0; i < 8; ++i) {
+      const double w = ((i & 1) ? fx : 1 - fx) * ((i & 2) ? fy : 1 - fy) * ((i & 4) ? fz : 1 - fz);
+      v += a[i] * w;
+      gg += g[i] * w;
+    }
+    phi = v;
+    grad = gg;
+  }
+  Vec3d gradient(const Vec3d& c, int x, int y, int z) const {
+    const double fx = c.x - x, fy = c.y - y, fz = c.z - z;
+    Vec3d gg{};
+    for (int i = 0; i < 8; ++i) {
+      const double w = ((i & 1) ? fx : 1 - fx) * ((i & 2) ? fy : 1 - fy) * ((i & 4) ? fz : 1 - fz);
+      gg += g[i] * w;
+    }
+    return gg;
+  }
+};
 
 // Local position of the vertex of loop l of cell (x,y,z).
-Vec3d loop_vertex(const CellTile& t, int x, int y, int z, const cell::LoopSet& ls, int l,
-                  double iso, int iterations) {
+Vec3d loop_vertex(const CellTile& t, const CellCorners& cc, int x, int y, int z, const cell::LoopSet& ls,
+                  int l, double iso, int iterations) {
   Vec3d c{};
   const int n = ls.length[l];
   for (int i = 0; i < n; ++i) {
@@ -61,8 +86,9 @@ Vec3d loop_vertex(const CellTile& t, int x, int y, int z, const cell::LoopSet& l
   }
   c = c / double(n);
   for (int it = 0; it < iterations; ++it) {
-    const double phi = trilinear(t, c, x, y, z, iso);
-    const Vec3d g = gradient_at(t, c, x, y, z);
+    double phi;
+    Vec3d g;
+    cc.eval(c, x, y, z, phi, g);
     const double gg = dot(g, g);
     if (!(gg > 1e-12)) break;
     c -= g * (phi / gg);
@@ -72,43 +98,71 @@ Vec3d loop_vertex(const CellTile& t, int x, int y, int z, const cell::LoopSet& l
   return c;
 }
 
+// Per-thread scratch: the tile and the loop vertices of the cells with min corner in [-1, 8)^3,
+// computed at most once per brick.
+struct Scratch {
+  CellTile tile;
+  std::array<std::uint8_t, ValidCells::kN * ValidCells::kN * ValidCells::kN> done{};
+  std::array<const cell::LoopSet*, ValidCells::kN * ValidCells::kN * ValidCells::kN> loops{};
+  std::array<std::array<Vec3d, 4>, ValidCells::kN * ValidCells::kN * ValidCells::kN> verts{};
+};
+
 void process_brick(const NarrowBand& band, std::uint32_t b, double iso, int iterations,
-                   CellTile& t, BrickOut& out) {
+                   Scratch& s, BrickOut& out) {
+  CellTile& t = s.tile;
   gather_cell_tile(band, b, t);
   const Coord base = brick_origin(band.bricks()[b].coord);
   const Vec3d bw{double(base.x), double(base.y), double(base.z)};
   const double h = band.voxel_size();
   const Vec3d org = band.origin();
   ValidCells valid;
-  valid.compute(t);
+  valid.compute(t, iso);
+  s.done.fill(0);
+
+  // Loops and vertices of a valid cell (cached).
+  auto cell_at = [&](int x, int y, int z) -> const cell::LoopSet& {
+    const int ci = ValidCells::index(x, y, z);
+    if (!s.done[ci]) {
+      s.done[ci] = 1;
+      const cell::LoopSet& ls = cell_loops(t, x, y, z, iso);
+      s.loops[ci] = &ls;
+      if (ls.loop_count != 0) {
+        const CellCorners cc(t, x, y, z, iso);
+        for (int l = 0; l < ls.loop_count; ++l) s.verts[ci][l] = loop_vertex(t, cc, x, y, z, ls, l, iso, iterations);
+      }
+    }
+    return *s.loops[ci];
+  };
 
   // Owned cell-loop vertices in slot order.
   for (int z = 0; z < kBrickDim; ++z)
     for (int y = 0; y < kBrickDim; ++y)
-      for (int x = 0; x < kBrickDim; ++x) {
-        if (!valid.at(x, y, z)) continue;
-        const cell::LoopSet& ls = cell_loops(t, x, y, z, iso);
+      for (std::uint32_t bits = (valid.mixed_row(y, z) >> ValidCells::kH) & 0xffu; bits != 0; bits &= bits - 1) {
+        const int x = std::countr_zero(bits);
+        const cell::LoopSet& ls = cell_at(x, y, z);
         if (ls.loop_count == 0) continue;
         ++out.cells;
+        const CellCorners cc(t, x, y, z, iso);
+        const int ci = ValidCells::index(x, y, z);
         for (int l = 0; l < ls.loop_count; ++l) {
-          const Vec3d c = loop_vertex(t, x, y, z, ls, l, iso, iterations);
+          const Vec3d c = s.verts[ci][l];
           out.owned.set(4 * local_index(x, y, z) + l);
           out.vertices.push_back(org + (bw + c) * h);
-          out.normals.push_back(normalized_f(gradient_at(t, c, x, y, z)));
+          out.normals.push_back(normalized_f(cc.gradient(c, x, y, z)));
         }
       }
 
   // Quads around owned crossing edges.
   for (int z = 0; z < kBrickDim; ++z)
-    for (int y = 0; y < kBrickDim; ++y)
-      for (int x = 0; x < kBrickDim; ++x) {
+    for (int y = 0; y < kBrickDim; ++y) {
+      std::uint32_t cr[3];
+      valid.crossing_edges(y, z, cr);
+      for (std::uint32_t bits = cr[0] | cr[1] | cr[2]; bits != 0; bits &= bits - 1) {
+        const int x = std::countr_zero(bits);
         const int p = CellTile::index(x, y, z);
-        if (!t.active[p]) continue;
         const bool p_in = double(t.values[p]) - iso < 0.0;
         for (int a = 0; a < 3; ++a) {
-          const int q = p + kTileStride[a];
-          if (!t.active[q]) continue;
-          if (p_in == (double(t.values[q]) - iso < 0.0)) continue;
+          if (!((cr[a] >> x) & 1u)) continue;
           const int bax = a == 0 ? 1 : 0, cax = a == 2 ? 1 : 2;
           static constexpr int kOrder[4][2] = {{0, 0}, {1, 0}, {1, 1}, {0, 1}};
           std::array<std::uint64_t, 4> key;
@@ -119,10 +173,10 @@ void process_brick(const NarrowBand& band, std::uint32_t b, double iso, int iter
             c[bax] -= kOrder[k][0];
             c[cax] -= kOrder[k][1];
             if (!valid.at(c[0], c[1], c[2])) { ok = false; break; }
-            const cell::LoopSet& ls = cell_loops(t, c[0], c[1], c[2], iso);
+            const cell::LoopSet& ls = cell_at(c[0], c[1], c[2]);
             const int e = 4 * a + kOrder[k][0] + 2 * kOrder[k][1];
             const int l = ls.loop_of_edge[e];
-            pos[k] = loop_vertex(t, c[0], c[1], c[2], ls, l, iso, iterations);
+            pos[k] = s.verts[ValidCells::index(c[0], c[1], c[2])][l];
             const int owner = CellTile::neighbor_slot(c[0] < 0 ? -1 : 0, c[1] < 0 ? -1 : 0, c[2] < 0 ? -1 : 0);
             key[k] = (std::uint64_t(t.around[owner]) << kSlotBits) |
                      std::uint64_t(4 * local_index(c[0] & 7, c[1] & 7, c[2] & 7) + l);
@@ -144,6 +198,7 @@ void process_brick(const NarrowBand& band, std::uint32_t b, double iso, int iter
           }
         }
       }
+    }
 }
 
 }  // namespace
@@ -155,9 +210,9 @@ SurfaceResult surface_nets(const NarrowBand& band, const SurfaceNetsOptions& opt
     throw Error(ErrorCode::InvalidArgument, "surface_nets", "relax_iterations must be >= 0");
   const std::uint32_t nb = std::uint32_t(band.brick_count());
   std::vector<BrickOut> outs(nb);
-  tbb::enumerable_thread_specific<CellTile> tiles;
+  tbb::enumerable_thread_specific<Scratch> scratch;
   for_brick_batches(nb, options.progress, "surface_nets", [&](std::uint32_t b) {
-    process_brick(band, b, options.iso, options.relax_iterations, tiles.local(), outs[b]);
+    process_brick(band, b, options.iso, options.relax_iterations, scratch.local(), outs[b]);
   });
   SurfaceResult r;
   std::vector<std::uint32_t> offset(nb + 1, 0);
