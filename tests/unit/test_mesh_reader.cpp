@@ -926,7 +926,7 @@ TEST(MeshReaderDispatch, ProgressAndCancellation) {
 TEST(MeshReaderDispatch, FuzzSeedCorpusIsValid) {
   // Every seed of the fuzz corpus is a valid file (so mutations start from good input).
   const std::filesystem::path dir =
-      std::filesystem::path(LEVELSET_TEST_DATA) / ".." / "fuzz" / "corpus" / "fuzz_mesh_reader";
+      std::filesystem::path(LEVELSET_FUZZ_CORPUS) / "fuzz_mesh_reader";
   ASSERT_TRUE(std::filesystem::is_directory(dir)) << dir;
   static constexpr const char* kExt[] = {".off", ".tria", ".ply", ".obj", ".stl"};
   int seen = 0;

@@ -229,8 +229,7 @@ TEST(PointCloudXyz, ReadsFromDisk) {
 }
 
 TEST(PointCloudXyz, FuzzSeedCorpusIsValid) {
-  const std::filesystem::path dir = std::filesystem::path(LEVELSET_TEST_DATA) / ".." / "fuzz" /
-                                    "corpus" / "fuzz_point_cloud_reader";
+  const std::filesystem::path dir = std::filesystem::path(LEVELSET_FUZZ_CORPUS) / "fuzz_point_cloud_reader";
   ASSERT_TRUE(std::filesystem::is_directory(dir)) << dir;
   static constexpr const char* kExt[] = {".xyz", ".xyzn", ".pwn", ".ply", ".off"};
   int seen = 0;
