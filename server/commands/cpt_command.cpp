@@ -2,8 +2,6 @@
 #include <chrono>
 #include <cstdio>
 
-#include <tbb/global_control.h>
-
 #include "commands/commands.hpp"
 #include "commands/report.hpp"
 #include "core/error.hpp"
@@ -42,8 +40,7 @@ int run_cpt(const CptArgs& args) {
               cpt.band.brick_count(), cpt.band.voxel_size(), std::chrono::duration<double>(t2 - t1).count(),
               args.output.c_str(), human_bytes(written.file_bytes).c_str());
 
-  Stats stats;
-  stats.op = "cpt";
+  Stats stats("cpt", cpt.band);
   auto secs = [](auto a, auto b) { return std::chrono::duration<double>(b - a).count(); };
   stats.seconds["read"] = secs(t0, t1);
   stats.seconds["orient"] = cpt.seconds.orient;
@@ -54,9 +51,6 @@ int run_cpt(const CptArgs& args) {
   stats.seconds["cpt"] = cpt.seconds.total;
   stats.seconds["write"] = secs(t2, t3);
   stats.seconds["total"] = secs(t0, t3);
-  stats.threads = int(tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism));
-  stats.active_voxels = cpt.band.active_voxel_count();
-  stats.bytes = cpt.band.memory_bytes();
   stats.extra["triangles"] = cpt.triangles;
   stats.extra["vertices"] = read.mesh.vertices.size();
   stats.extra["bricks"] = cpt.band.brick_count();

@@ -2,8 +2,6 @@
 #include <chrono>
 #include <cstdio>
 
-#include <tbb/global_control.h>
-
 #include "commands/commands.hpp"
 #include "commands/report.hpp"
 #include "grid/lsg_file.hpp"
@@ -41,15 +39,11 @@ int run_mesh(const MeshArgs& args) {
                args.method.c_str(), args.iso,
                m.watertight && m.manifold ? "watertight and manifold" : "open or non-manifold",
                secs(t1, t2), args.output.c_str());
-  Stats stats;
-  stats.op = "mesh";
+  Stats stats("mesh", in.band);
   stats.seconds["read"] = secs(t0, t1);
   stats.seconds["extract"] = secs(t1, t2);
   stats.seconds["write"] = secs(t2, t3);
   stats.seconds["total"] = secs(t0, t3);
-  stats.threads = int(tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism));
-  stats.active_voxels = in.band.active_voxel_count();
-  stats.bytes = in.band.memory_bytes();
   stats.extra["method"] = args.method;
   stats.extra["iso"] = args.iso;
   stats.extra["vertices"] = surface.mesh.vertices.size();

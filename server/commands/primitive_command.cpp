@@ -2,8 +2,6 @@
 #include <chrono>
 #include <cstdio>
 
-#include <tbb/global_control.h>
-
 #include "commands/commands.hpp"
 #include "commands/report.hpp"
 #include "geometry/analytic_shapes.hpp"
@@ -29,14 +27,10 @@ int run_primitive(const PrimitiveArgs& args) {
               human_bytes(band.memory_bytes()).c_str(), args.output.c_str(),
               human_bytes(written.file_bytes).c_str());
 
-  Stats stats;
-  stats.op = "primitive";
+  Stats stats("primitive", band);
   stats.seconds["build"] = std::chrono::duration<double>(t1 - t0).count();
   stats.seconds["write"] = std::chrono::duration<double>(t2 - t1).count();
   stats.seconds["total"] = std::chrono::duration<double>(t2 - t0).count();
-  stats.threads = int(tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism));
-  stats.active_voxels = band.active_voxel_count();
-  stats.bytes = band.memory_bytes();
   stats.extra["shape"] = args.shape;
   stats.extra["resolution"] = args.resolution;
   stats.extra["voxel_size"] = band.voxel_size();

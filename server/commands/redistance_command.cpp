@@ -2,8 +2,6 @@
 #include <chrono>
 #include <cstdio>
 
-#include <tbb/global_control.h>
-
 #include "commands/commands.hpp"
 #include "commands/report.hpp"
 #include "distance/redistance.hpp"
@@ -28,15 +26,11 @@ int run_redistance(const RedistanceArgs& args) {
   std::fprintf(summary_stream(args.stats), "%s: %zu -> %zu active voxels (%s), %.3f s -> %s (%s)\n", args.input.c_str(),
               in.band.active_voxel_count(), result.band.active_voxel_count(), args.method.c_str(),
               secs(t1, t2), args.output.c_str(), human_bytes(written.file_bytes).c_str());
-  Stats stats;
-  stats.op = "redistance";
+  Stats stats("redistance", result.band);
   stats.seconds["read"] = secs(t0, t1);
   stats.seconds["redistance"] = secs(t1, t2);
   stats.seconds["write"] = secs(t2, t3);
   stats.seconds["total"] = secs(t0, t3);
-  stats.threads = int(tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism));
-  stats.active_voxels = result.band.active_voxel_count();
-  stats.bytes = result.band.memory_bytes();
   stats.extra["method"] = args.method;
   stats.extra["order"] = args.order;
   stats.extra["input_active_voxels"] = in.band.active_voxel_count();

@@ -2,10 +2,19 @@
 
 #include <cstdio>
 #include <iostream>
+#include <utility>
+
+#include <tbb/global_control.h>
 
 #include "core/file_io.hpp"
 
 namespace levelset::cli {
+
+Stats::Stats(std::string op_name, const NarrowBand& band)
+    : op(std::move(op_name)),
+      threads(int(tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism))),
+      active_voxels(band.active_voxel_count()),
+      bytes(band.memory_bytes()) {}
 
 nlohmann::json Stats::to_json() const {
   nlohmann::json j = extra;

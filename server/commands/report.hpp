@@ -12,9 +12,14 @@
 
 #include <nlohmann/json.hpp>
 
+#include "grid/narrow_band.hpp"
+
 namespace levelset::cli {
 
 struct Stats {
+  // A record for `op` about `band`: threads in use, its active voxels and bytes.
+  Stats(std::string op_name, const NarrowBand& band);
+
   std::string op;
   nlohmann::json seconds = nlohmann::json::object();
   nlohmann::json extra = nlohmann::json::object();
