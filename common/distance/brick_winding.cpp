@@ -3,7 +3,10 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <limits>
 #include <utility>
+
+#include "geometry/point_triangle.hpp"
 
 namespace levelset {
 
@@ -44,13 +47,46 @@ BrickMask dilate(const BrickMask& m) {
   return d;
 }
 
-int pick_reference(const BrickMask& near) {
+// `rejected`: candidates found too close to the surface (avoided on every tier).
+int pick_reference(const BrickMask& near, const BrickMask& rejected) {
   const BrickMask d1 = dilate(near);
   const BrickMask d2 = dilate(d1);
   for (const BrickMask* avoid : {&d2, &d1, &near})
     for (std::uint16_t n : kCandidates)
-      if (!avoid->test(n)) return n;
-  return kCandidates[0];
+      if (!avoid->test(n) && !rejected.test(n)) return n;
+  return -1;
+}
+
+// The reference's winding number comes from the tree, evaluated at the world-space voxel
+// centre, while the jumps use the grid-space copy of the mesh with the symbolic perturbation.
+// A centre (nearly) on the surface -- e.g. on a box edge or corner that is off every grid line
+// through it by a rounding error of (v - origin) / h, so that no crossed edge marks it `near` --
+// gets an unreliable value there (the solid angle jumps across the surface; world and grid
+// space may disagree on the side). The reference must therefore keep this distance (in voxels)
+// from every triangle; listed triangles are all those within the brick's margin of it.
+constexpr double kReferenceClearance = 0.05;
+
+double distance_squared_to_surface(std::span<const GridTriangle> triangles,
+                                   std::span<const std::uint32_t> ids, const Vec3d& p,
+                                   double stop_below) {
+  double best = std::numeric_limits<double>::infinity();
+  for (std::uint32_t id : ids) {
+    const GridTriangle& t = triangles[id];
+    // Cheap bounding-box rejection first.
+    double box = 0.0;
+    for (int a = 0; a < 3; ++a) {
+      const double lo = std::min({t.corner[0][a], t.corner[1][a], t.corner[2][a]});
+      const double hi = std::max({t.corner[0][a], t.corner[1][a], t.corner[2][a]});
+      const double d = p[a] < lo ? lo - p[a] : (p[a] > hi ? p[a] - hi : 0.0);
+      box += d * d;
+    }
+    if (box >= best) continue;
+    best = std::min(best, closest_point_on_triangle(p, t.corner[0], t.corner[1],
+                                                            t.corner[2])
+                              .distance_squared);
+    if (best < stop_below) break;
+  }
+  return best;
 }
 
 // rel[n] for the voxels n of the block [lo, lo + s)^3: the sum of jumps along the path
@@ -217,13 +253,21 @@ BrickMask inside_from_reference(std::span<const GridTriangle> triangles,
   // Lines along z everywhere; along x and y only those of the path from the reference (its
   // x-row, the y-lines of its z-slice). A reference found next to a crossing on them is
   // replaced (those crossings now count in `near`), up to kMaxReferenceTries times.
+  // A reference too close to the surface (kReferenceClearance) is rejected and replaced, up to
+  // kMaxClearanceTries times; failing that, the clearest candidate tried is used.
   constexpr int kMaxReferenceTries = 4;
+  constexpr int kMaxClearanceTries = 64;
   x = BrickCrossings{};
   LineSet done{0, 0, ~0ull};
   brick_crossings(triangles, ids, brick, done, x);
-  int r = 0;
-  for (int attempt = 0; attempt < kMaxReferenceTries; ++attempt) {
-    r = pick_reference(x.near);
+  const Coord o = brick_origin(brick);
+  constexpr double kClear2 = kReferenceClearance * kReferenceClearance;
+  BrickMask rejected;
+  int r = kCandidates[0];
+  int best = -1;
+  double best_d2 = -1.0;
+  // The lines of the path from reference r (computed once each).
+  auto add_path_lines = [&](int r) {
     const Coord c = local_coord(r);
     LineSet add{0, 0, 0};
     add[0] = (std::uint64_t{1} << (c.y + 8 * c.z)) & ~done[0];
@@ -234,8 +278,31 @@ BrickMask inside_from_reference(std::span<const GridTriangle> triangles,
       done[0] |= add[0];
       done[1] |= add[1];
     }
+  };
+  for (int attempt = 0, clearance_tries = 0; attempt < kMaxReferenceTries;) {
+    const int pick = pick_reference(x.near, rejected);
+    if (pick < 0) {  // every candidate rejected: the clearest one tried
+      if (best >= 0) r = best;
+      break;
+    }
+    r = pick;
+    const Coord c = local_coord(r);
+    const Vec3d p{double(o.x + c.x), double(o.y + c.y), double(o.z + c.z)};
+    const double d2 = distance_squared_to_surface(triangles, ids, p, kClear2);
+    if (d2 < kClear2) {
+      if (d2 > best_d2) {
+        best_d2 = d2;
+        best = r;
+      }
+      rejected.set(r);
+      if (++clearance_tries < kMaxClearanceTries) continue;
+      r = best;
+    }
+    ++attempt;
+    add_path_lines(r);
     if (!x.near.test(r)) break;
   }
+  add_path_lines(r);
   const double w_ref = query(context, brick, r, queries);
   int rel[kBrickVoxels];
   propagate(x, local_coord(r), Coord{0, 0, 0}, kBrickDim, rel);

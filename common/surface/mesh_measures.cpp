@@ -151,4 +151,54 @@ MeshMeasures measure_mesh(const TriangleMesh& mesh) {
   return m;
 }
 
+double area_weighted_mean_curvature(const TriangleMesh& mesh) {
+  const std::size_t nv = mesh.vertices.size();
+  const std::size_t nf = mesh.triangles.size();
+  std::vector<Vec3d> normals(nf);
+  double area = 0.0;
+  struct FaceEdge {
+    std::uint32_t lo, hi, face;
+    bool forward;  // lo -> hi in the face
+  };
+  std::vector<FaceEdge> edges;
+  edges.reserve(3 * nf);
+  for (std::size_t f = 0; f < nf; ++f) {
+    const auto& t = mesh.triangles[f];
+    for (auto i : t)
+      if (i >= nv)
+        throw Error(ErrorCode::InvalidArgument, "area_weighted_mean_curvature", "vertex index out of range");
+    const Vec3d n = cross(mesh.vertices[t[1]] - mesh.vertices[t[0]], mesh.vertices[t[2]] - mesh.vertices[t[0]]);
+    const double len = length(n);
+    area += 0.5 * len;
+    normals[f] = len > 0.0 ? n / len : Vec3d{};
+    for (int k = 0; k < 3; ++k) {
+      const std::uint32_t u = t[k], v = t[(k + 1) % 3];
+      edges.push_back({std::min(u, v), std::max(u, v), std::uint32_t(f), u < v});
+    }
+  }
+  if (!(area > 0.0)) return 0.0;
+  std::sort(edges.begin(), edges.end(), [](const FaceEdge& a, const FaceEdge& b) {
+    return a.lo != b.lo ? a.lo < b.lo : (a.hi != b.hi ? a.hi < b.hi : a.face < b.face);
+  });
+  double integral = 0.0;
+  for (std::size_t i = 0; i < edges.size();) {
+    std::size_t j = i;
+    while (j < edges.size() && edges[j].lo == edges[i].lo && edges[j].hi == edges[i].hi) ++j;
+    if (j - i == 2 && edges[i].forward != edges[i + 1].forward) {
+      // Direct the edge as face 1 traverses it; theta > 0 where convex.
+      const FaceEdge& e1 = edges[i].forward ? edges[i] : edges[i + 1];
+      const FaceEdge& e2 = edges[i].forward ? edges[i + 1] : edges[i];
+      const Vec3d ev = mesh.vertices[e1.hi] - mesh.vertices[e1.lo];
+      const double elen = length(ev);
+      const Vec3d &n1 = normals[e1.face], &n2 = normals[e2.face];
+      if (elen > 0.0 && dot(n1, n1) > 0.0 && dot(n2, n2) > 0.0) {
+        const double theta = std::atan2(dot(cross(n1, n2), ev) / elen, dot(n1, n2));
+        integral += elen * theta;
+      }
+    }
+    i = j;
+  }
+  return integral / area;
+}
+
 }  // namespace levelset

@@ -40,4 +40,17 @@ struct MeshMeasures {
 
 MeshMeasures measure_mesh(const TriangleMesh& mesh);
 
+// area_weighted_mean_curvature: the area-weighted average of the mean curvature over a closed
+//   triangle mesh, with the convention H = k1 + k2 (sum of the principal curvatures, NOT their
+//   mean): a sphere of radius r gives 2/r; a torus (major R, minor r) gives 1/r.
+// Method: the discrete integral of H over the surface is the sum over interior edges of
+//   |e| * theta_e, theta_e the signed dihedral angle between the two face normals (positive
+//   where the surface is convex with respect to its outward/face-orientation normals); it is
+//   divided by the total area. Edges that are not shared by exactly two consistently oriented
+//   triangles (boundary, non-manifold, misoriented) and edges next to a zero-area triangle
+//   contribute nothing. Meaningful for closed, oriented meshes with outward orientation.
+// Cost: O(F log F) time, O(F) memory. Threading: serial, reentrant.
+// Errors: Error{InvalidArgument} for an index out of range; returns 0 for zero total area.
+double area_weighted_mean_curvature(const TriangleMesh& mesh);
+
 }  // namespace levelset

@@ -2,6 +2,8 @@
 
 #include <cmath>
 #include <cstdlib>
+#include <fstream>
+#include <string>
 #include <memory>
 #include <random>
 #include <utility>
@@ -142,6 +144,68 @@ TEST(InsideMasks, GridAlignedBoxHasNoSpecklesAndFollowsTheSurfaceConvention) {
     });
     EXPECT_GT(on_surface, 1000u);
   }
+}
+
+// Large triangles (one pair per face) whose edges and corners lie exactly on voxel centres and
+// grid lines, at several positions relative to the brick boundaries (faces on the first, last
+// and middle voxels of a brick, boxes spanning one or many bricks).
+TEST(InsideMasks, CoarseGridAlignedBoxesFollowTheSurfaceConventionEverywhere) {
+  const double h = 0.25;
+  const Vec3d origin{-1.0, 0.5, -2.0};
+  const std::vector<std::pair<std::array<int, 3>, std::array<int, 3>>> boxes = {
+      {{3, 3, 3}, {125, 125, 125}}, {{0, 0, 0}, {7, 7, 7}},     {{7, 8, 15}, {16, 23, 24}},
+      {{-8, -1, 1}, {8, 15, 6}},    {{1, 6, 7}, {2, 7, 8}},     {{-5, 3, 0}, {40, 31, 39}},
+      {{8, 8, 8}, {9, 40, 17}},     {{3, -9, 4}, {60, 5, 13}}};
+  for (const auto& [lo, hi] : boxes)
+    for (int step : {1000, 5}) {
+      const TriangleMesh box = to_world(test::grid_box(lo, hi, step), h, origin);
+      const Masks m = compute(box, h, origin);
+      ASSERT_EQ(m.result.open_edges, 0u);
+      std::size_t wrong = 0;
+      m.for_each_voxel([&](const Vec3d&, const Coord& g, bool bit) {
+        bool expected = true;
+        for (int a = 0; a < 3; ++a) expected = expected && lo[a] < g[a] && g[a] <= hi[a];
+        if (bit != expected && ++wrong <= 5)
+          ADD_FAILURE() << "box " << lo[0] << " " << lo[1] << " " << lo[2] << " .. " << hi[0]
+                        << " " << hi[1] << " " << hi[2] << " step " << step << " voxel " << g.x
+                        << " " << g.y << " " << g.z << " bit " << bit;
+      });
+      EXPECT_EQ(wrong, 0u);
+    }
+}
+
+// CGAL's cheese-box.off: an axis-aligned cube of half side 0.066550000931700007; at the frame
+// the server uses for -r 128 (voxel size 0.1331 / 122, cube from voxel 3 to 125) its faces lie
+// on voxel planes and its corners on voxel centres (up to the rounding of (v - origin) / h, so
+// only voxels at least 1e-6 voxels off the surface are checked).
+TEST(InsideMasks, CheeseBoxOnVoxelCentresMatchesTheAnalyticBox) {
+  const std::string path = std::string(LEVELSET_CGAL_DATA) + "/meshes/cheese-box.off";
+  if (!std::ifstream(path).good()) GTEST_SKIP() << "missing " << path;
+  const TriangleMesh mesh = orient_faces(test::load_cgal_mesh("cheese-box.off"), {}).mesh;
+  ASSERT_EQ(mesh.triangles.size(), 12u);
+  Vec3d lo = mesh.vertices[0], hi = mesh.vertices[0];
+  for (const Vec3d& v : mesh.vertices)
+    for (int a = 0; a < 3; ++a) {
+      lo[a] = std::min(lo[a], v[a]);
+      hi[a] = std::max(hi[a], v[a]);
+    }
+  const double h = (hi.x - lo.x) / 122.0;
+  const Vec3d origin = lo - Vec3d{3.0, 3.0, 3.0} * h;
+  const Masks m = compute(mesh, h, origin);
+  std::size_t wrong = 0, checked = 0;
+  m.for_each_voxel([&](const Vec3d&, const Coord& g, bool bit) {
+    double sd = -1e300;  // signed distance to the box in voxels (> 0 outside)
+    for (int a = 0; a < 3; ++a) {
+      const double c = (origin[a] + double(g[a]) * h - 0.5 * (lo[a] + hi[a])) / h;
+      sd = std::max(sd, std::abs(c) - 0.5 * (hi[a] - lo[a]) / h);
+    }
+    if (std::abs(sd) < 1e-6) return;
+    ++checked;
+    if (bit != (sd < 0.0) && ++wrong <= 5)
+      ADD_FAILURE() << "voxel " << g.x << " " << g.y << " " << g.z << " bit " << bit;
+  });
+  EXPECT_EQ(wrong, 0u);
+  EXPECT_GT(checked, 10000u);
 }
 
 TEST(InsideMasks, GridAlignedOctahedronFollowsTheSymbolicPerturbation) {
