@@ -126,41 +126,16 @@ SurfaceResult marching_cubes(const NarrowBand& band, const MarchingCubesOptions&
   });
 
   SurfaceResult r;
-  std::vector<std::uint32_t> offset(nb + 1, 0);
-  std::uint64_t total = 0, tris = 0;
-  for (std::uint32_t b = 0; b < nb; ++b) {
-    offset[b] = std::uint32_t(total);
-    total += outs[b].vertices.size();
-    tris += outs[b].triangles.size();
-    outs[b].owned.finish();
-    r.cells_with_surface += outs[b].cells;
-    r.extra_vertices += outs[b].extra;
-  }
-  if (total >= 0xffffffffull) throw Error(ErrorCode::LimitExceeded, "marching_cubes", "more than 2^32 - 1 vertices");
-  offset[nb] = std::uint32_t(total);
-  r.mesh.vertices.resize(total);
-  r.normals.resize(total);
-  r.mesh.triangles.resize(tris);
-  std::vector<std::uint64_t> tri_offset(nb + 1, 0);
-  for (std::uint32_t b = 0; b < nb; ++b) tri_offset[b + 1] = tri_offset[b] + outs[b].triangles.size();
+  for (const BrickOut& o : outs) r.extra_vertices += o.extra;
+  const MergeOffsets m = merge_offsets(outs, r, "marching_cubes");
   auto remap = [&](std::uint64_t k) {
     const std::uint32_t owner = std::uint32_t(k >> kSlotBits);
     const int slot = int(k & ((1u << kSlotBits) - 1));
     const BrickOut& o = outs[owner];
-    return slot < kEdgeSlots ? offset[owner] + o.owned.rank(slot)
-                             : offset[owner] + o.edge_vertices + std::uint32_t(slot - kEdgeSlots);
+    return slot < kEdgeSlots ? m.vertex[owner] + o.owned.rank(slot)
+                             : m.vertex[owner] + o.edge_vertices + std::uint32_t(slot - kEdgeSlots);
   };
-  tbb::parallel_for(tbb::blocked_range<std::uint32_t>(0, nb, 64), [&](const tbb::blocked_range<std::uint32_t>& rg) {
-    for (std::uint32_t b = rg.begin(); b != rg.end(); ++b) {
-      const BrickOut& o = outs[b];
-      std::copy(o.vertices.begin(), o.vertices.end(), r.mesh.vertices.begin() + offset[b]);
-      std::copy(o.normals.begin(), o.normals.end(), r.normals.begin() + offset[b]);
-      for (std::size_t i = 0; i < o.triangles.size(); ++i) {
-        const auto& k = o.triangles[i];
-        r.mesh.triangles[tri_offset[b] + i] = {remap(k[0]), remap(k[1]), remap(k[2])};
-      }
-    }
-  });
+  copy_merged(outs, m, remap, r);
   r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return r;
 }

@@ -9,12 +9,19 @@
 #include <cmath>
 #include <cstdint>
 #include <functional>
+#include <string>
 #include <string_view>
+#include <vector>
 
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include "core/error.hpp"
 #include "core/progress.hpp"
 #include "core/vec3.hpp"
 #include "grid/narrow_band.hpp"
 #include "surface/cell_tile.hpp"
+#include "surface/surface_result.hpp"
 
 namespace levelset::surface_detail {
 
@@ -203,5 +210,51 @@ void check_iso(const NarrowBand& band, double iso, std::string_view where);
 // f(brick) for every brick: TBB inside batches, progress.step between batches (serial).
 void for_brick_batches(std::uint32_t bricks, const ProgressHook& progress, std::string_view stage,
                        const std::function<void(std::uint32_t)>& f);
+
+// Concatenation of per-brick outputs in brick order, shared by both extractors. Out needs
+// `vertices`, `normals`, `triangles` (3 brick-local keys each), `owned` (finish()) and `cells`.
+// merge_offsets sizes the result and returns each brick's first vertex and triangle;
+// copy_merged fills it in parallel, mapping keys to global indices with remap(key).
+struct MergeOffsets {
+  std::vector<std::uint32_t> vertex;    // first vertex of each brick (bricks + 1 entries)
+  std::vector<std::uint64_t> triangle;  // first triangle of each brick (bricks + 1 entries)
+};
+
+template <typename Out>
+MergeOffsets merge_offsets(std::vector<Out>& outs, SurfaceResult& r, std::string_view who) {
+  const std::size_t nb = outs.size();
+  MergeOffsets m{std::vector<std::uint32_t>(nb + 1, 0), std::vector<std::uint64_t>(nb + 1, 0)};
+  std::uint64_t total = 0;
+  for (std::size_t b = 0; b < nb; ++b) {
+    m.vertex[b] = std::uint32_t(total);
+    total += outs[b].vertices.size();
+    if (total >= 0xffffffffull)
+      throw Error(ErrorCode::LimitExceeded, std::string(who), "more than 2^32 - 1 vertices");
+    m.triangle[b + 1] = m.triangle[b] + outs[b].triangles.size();
+    outs[b].owned.finish();
+    r.cells_with_surface += outs[b].cells;
+  }
+  m.vertex[nb] = std::uint32_t(total);
+  r.mesh.vertices.resize(total);
+  r.normals.resize(total);
+  r.mesh.triangles.resize(m.triangle[nb]);
+  return m;
+}
+
+template <typename Out, typename Remap>
+void copy_merged(const std::vector<Out>& outs, const MergeOffsets& m, Remap&& remap, SurfaceResult& r) {
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, outs.size(), 64),
+                    [&](const tbb::blocked_range<std::size_t>& rg) {
+    for (std::size_t b = rg.begin(); b != rg.end(); ++b) {
+      const Out& o = outs[b];
+      std::copy(o.vertices.begin(), o.vertices.end(), r.mesh.vertices.begin() + m.vertex[b]);
+      std::copy(o.normals.begin(), o.normals.end(), r.normals.begin() + m.vertex[b]);
+      for (std::size_t i = 0; i < o.triangles.size(); ++i) {
+        const auto& k = o.triangles[i];
+        r.mesh.triangles[m.triangle[b] + i] = {remap(k[0]), remap(k[1]), remap(k[2])};
+      }
+    }
+  });
+}
 
 }  // namespace levelset::surface_detail

@@ -215,35 +215,12 @@ SurfaceResult surface_nets(const NarrowBand& band, const SurfaceNetsOptions& opt
     process_brick(band, b, options.iso, options.relax_iterations, scratch.local(), outs[b]);
   });
   SurfaceResult r;
-  std::vector<std::uint32_t> offset(nb + 1, 0);
-  std::vector<std::uint64_t> tri_offset(nb + 1, 0);
-  std::uint64_t total = 0;
-  for (std::uint32_t b = 0; b < nb; ++b) {
-    offset[b] = std::uint32_t(total);
-    total += outs[b].vertices.size();
-    tri_offset[b + 1] = tri_offset[b] + outs[b].triangles.size();
-    outs[b].owned.finish();
-    r.cells_with_surface += outs[b].cells;
-  }
-  if (total >= 0xffffffffull) throw Error(ErrorCode::LimitExceeded, "surface_nets", "more than 2^32 - 1 vertices");
-  r.mesh.vertices.resize(total);
-  r.normals.resize(total);
-  r.mesh.triangles.resize(tri_offset[nb]);
+  const MergeOffsets m = merge_offsets(outs, r, "surface_nets");
   auto remap = [&](std::uint64_t k) {
     const std::uint32_t owner = std::uint32_t(k >> kSlotBits);
-    return offset[owner] + outs[owner].owned.rank(int(k & ((1u << kSlotBits) - 1)));
+    return m.vertex[owner] + outs[owner].owned.rank(int(k & ((1u << kSlotBits) - 1)));
   };
-  tbb::parallel_for(tbb::blocked_range<std::uint32_t>(0, nb, 64), [&](const tbb::blocked_range<std::uint32_t>& rg) {
-    for (std::uint32_t b = rg.begin(); b != rg.end(); ++b) {
-      const BrickOut& o = outs[b];
-      std::copy(o.vertices.begin(), o.vertices.end(), r.mesh.vertices.begin() + offset[b]);
-      std::copy(o.normals.begin(), o.normals.end(), r.normals.begin() + offset[b]);
-      for (std::size_t i = 0; i < o.triangles.size(); ++i) {
-        const auto& k = o.triangles[i];
-        r.mesh.triangles[tri_offset[b] + i] = {remap(k[0]), remap(k[1]), remap(k[2])};
-      }
-    }
-  });
+  copy_merged(outs, m, remap, r);
   r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return r;
 }
