@@ -5,6 +5,9 @@
 
 #include <bit>
 #include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
 #include <string>
 #include <string_view>
 #include <utility>
@@ -28,6 +31,28 @@ template <typename Read, typename Describe>
              << "got '" << e.what() << "'; expected " << to_string(code) << " at " << where;
     return ::testing::AssertionSuccess() << e.what();
   }
+}
+
+// Visits every seed of a fuzz corpus directory under LEVELSET_FUZZ_CORPUS: the first byte of a
+// seed picks the extension from `extensions` (as the fuzz targets do), the rest is the file.
+// visit(bytes, name) must read it successfully. Returns the number of seeds seen.
+template <std::size_t N, typename Visit>
+int for_each_fuzz_seed(const char* corpus, const char* const (&extensions)[N], Visit&& visit) {
+  const std::filesystem::path dir = std::filesystem::path(LEVELSET_FUZZ_CORPUS) / corpus;
+  EXPECT_TRUE(std::filesystem::is_directory(dir)) << dir;
+  if (!std::filesystem::is_directory(dir)) return 0;
+  int seen = 0;
+  for (const auto& entry : std::filesystem::directory_iterator(dir)) {
+    std::ifstream in(entry.path(), std::ios::binary);
+    const std::string bytes{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+    EXPECT_FALSE(bytes.empty()) << entry.path();
+    if (bytes.empty()) continue;
+    EXPECT_LT(bytes.size(), 4096u) << entry.path();
+    const std::string name = entry.path().stem().string() + extensions[static_cast<unsigned char>(bytes[0]) % N];
+    EXPECT_NO_THROW(visit(std::string_view(bytes).substr(1), name)) << entry.path();
+    ++seen;
+  }
+  return seen;
 }
 
 // Little/big-endian binary builder for PLY and STL inputs.

@@ -925,24 +925,10 @@ TEST(MeshReaderDispatch, ProgressAndCancellation) {
 
 TEST(MeshReaderDispatch, FuzzSeedCorpusIsValid) {
   // Every seed of the fuzz corpus is a valid file (so mutations start from good input).
-  const std::filesystem::path dir =
-      std::filesystem::path(LEVELSET_FUZZ_CORPUS) / "fuzz_mesh_reader";
-  ASSERT_TRUE(std::filesystem::is_directory(dir)) << dir;
   static constexpr const char* kExt[] = {".off", ".tria", ".ply", ".obj", ".stl"};
-  int seen = 0;
-  for (const auto& entry : std::filesystem::directory_iterator(dir)) {
-    std::ifstream in(entry.path(), std::ios::binary);
-    const std::string bytes{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-    ASSERT_FALSE(bytes.empty());
-    EXPECT_LT(bytes.size(), 4096u) << entry.path();
-    const std::string name =
-        entry.path().stem().string() + kExt[static_cast<unsigned char>(bytes[0]) % 5];
-    EXPECT_NO_THROW({
-      const MeshReadResult r = read(std::string_view(bytes).substr(1), name);
-      EXPECT_FALSE(r.mesh.triangles.empty()) << entry.path();
-    }) << entry.path();
-    ++seen;
-  }
+  const int seen = test::for_each_fuzz_seed("fuzz_mesh_reader", kExt, [](std::string_view bytes, const std::string& name) {
+    EXPECT_FALSE(read(bytes, name).mesh.triangles.empty()) << name;
+  });
   EXPECT_GE(seen, 10);
 }
 
