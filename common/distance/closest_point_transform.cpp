@@ -1,5 +1,6 @@
 #include "distance/closest_point_transform.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <limits>
@@ -224,24 +225,20 @@ CptResult closest_point_transform(const TriangleMesh& mesh, const CptOptions& op
     const BrickMask& inside = records[j].inside;
     float* dst = values.data() + offsets[j];
     std::size_t k = 0;
+    // The sign is the inside mask's, always: an inside voxel whose distance rounds to 0 (or
+    // to a subnormal) gets -FLT_MIN, not -0 (-0 < 0 is false: it would read as outside).
+    // Voxels exactly on the surface otherwise get a sign from the rounding of the distance
+    // (exactly 0 or ~1e-18), a random inside/outside pattern that changes the topology of
+    // the zero level (CGAL's corner.off at R = 128: genus 0 -> 6 under marching cubes).
+    constexpr float kTiny = std::numeric_limits<float>::min();
     bd.active.for_each_set([&](int n) {
-      dst[k] = inside.test(n) ? -bd.distance[k] : bd.distance[k];
+      dst[k] = inside.test(n) ? -std::max(bd.distance[k], kTiny) : bd.distance[k];
       ++k;
     });
     if (options.closest_points)
       std::copy(bd.closest_point.begin(), bd.closest_point.end(),
                 result.closest_points.begin() + std::ptrdiff_t(offsets[j]));
   });
-  // A voxel exactly on the surface has distance 0: keep its sign bit consistent with the
-  // value's sign (-0 < 0 is false), as the band requires.
-  for (std::size_t j = 0; j < kept.size(); ++j) {
-    const float* v = values.data() + offsets[j];
-    std::size_t k = 0;
-    records[j].active.for_each_set([&](int n) {
-      if (records[j].inside.test(n) && !(v[k] < 0.0f)) records[j].inside.reset(n);
-      ++k;
-    });
-  }
   result.band = NarrowBand::assemble(options.frame, std::move(records), std::move(values), false);
   result.seconds.assemble = since(t);
   result.seconds.total = since(t_start);

@@ -6,7 +6,9 @@
 // Output: a NarrowBand holding, at every voxel within W*h of the mesh, the exact Euclidean
 //   distance to the closest point of the mesh, negative inside; and on request the closest
 //   point itself per active voxel (in band value order), for the client's 'vector to closest
-//   point' display and for extension velocities.
+//   point' display and for extension velocities. The sign is the inside mask's at every voxel,
+//   also exactly on the surface (compute_inside_masks' convention): an inside voxel at
+//   distance 0 holds -FLT_MIN, never -0, so value < 0 is exactly the winding-number inside.
 // Method: (thesis 2.3.4, 4.5) triangles are binned to the bricks they come within W*h of;
 //   each brick then scan-converts its triangles' slabs (|plane distance| <= W*h, per column of
 //   the dominant axis) and keeps the minimum exact point-triangle distance per voxel (ties:

@@ -90,6 +90,12 @@ class NarrowBand {
     if (br.signs == kSignsAllInside) return true;
     return sign_masks_[br.signs].test(n);
   }
+  // stored_inside for the 64 voxels of z-slice w of a brick at once (bit = local_index & 63).
+  std::uint64_t stored_inside_word(const Brick& br, int w) const {
+    if (br.signs == kSignsAllOutside) return 0;
+    if (br.signs == kSignsAllInside) return ~std::uint64_t{0};
+    return sign_masks_[br.signs].words[std::size_t(w)];
+  }
   // Sign of voxel n of brick b, active or not.
   bool voxel_inside(std::uint32_t b, int n) const {
     const Brick& br = bricks_[b];

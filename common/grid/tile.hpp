@@ -30,6 +30,10 @@ struct TileShape {
 
 // halo in [0, 8]. out.size() must be TileShape{halo}.size().
 void gather_tile(const NarrowBand& band, std::uint32_t brick, int halo, std::span<float> out);
+// Same, and active_rows (size dim^2, one entry per tile row (y, z) at (y+halo) + dim*(z+halo))
+// gets bit x+halo set where voxel (x, y, z) is active (stored in the band).
+void gather_tile(const NarrowBand& band, std::uint32_t brick, int halo, std::span<float> out,
+                 std::span<std::uint32_t> active_rows);
 
 // Dense 512 values of one brick (halo 0) into out[local_index].
 void decode_brick(const NarrowBand& band, std::uint32_t brick, std::span<float, kBrickVoxels> out);

@@ -1,8 +1,8 @@
 // CellTile: one brick's values and active flags with a halo of 2, for the surface extractors.
 //
 // Inputs: a band and a brick index. Output: dense (8+4)^3 arrays (layout of grid/tile.hpp,
-// halo 2): values (+-background outside the band), active flags (1 where the band stores the
-// voxel), and the indices of the brick and its 26 neighbours (around[neighbor_slot(d)] for
+// halo 2): values (+-background outside the band), active row bitmasks (bit x + kHalo of row
+// (y, z) where the band stores voxel (x, y, z)), and the indices of the brick and its 26 neighbours (around[neighbor_slot(d)] for
 // d in {-1,0,1}^3; kNoBrick where unallocated). Cost: O(12^3) plus up to 26 neighbour resolutions (face links,
 // a hash lookup only for a diagonal brick whose face path is unallocated). Threading: one
 // tile per thread; the band is read only.
@@ -24,7 +24,8 @@ struct CellTile {
     return (x + kHalo) + kDim * ((y + kHalo) + kDim * (z + kHalo));
   }
   std::vector<float> values = std::vector<float>(kSize);
-  std::vector<std::uint8_t> active = std::vector<std::uint8_t>(kSize);
+  static constexpr int row(int y, int z) { return (y + kHalo) + kDim * (z + kHalo); }
+  std::array<std::uint32_t, kDim * kDim> active_rows{};
   static constexpr int neighbor_slot(int dx, int dy, int dz) { return (dx + 1) + 3 * (dy + 1) + 9 * (dz + 1); }
   std::array<std::uint32_t, 27> around{};
 };

@@ -20,42 +20,54 @@ using namespace surface_detail;
 
 namespace {
 
-constexpr int kEdgeSlots = kBrickVoxels * 3;  // 1536
-constexpr int kSlotBits = 12;
+constexpr int kEdgeSlots = kBrickVoxels * 3;  // 1536; centroids follow
 
 struct BrickOut {
   std::vector<Vec3d> vertices;   // owned edge vertices in slot order, then centroids
   std::vector<Vec3f> normals;
-  std::vector<std::array<std::uint64_t, 3>> triangles;  // owner << 12 | slot
+  std::vector<std::array<VertexKey, 3>> triangles;
+  std::array<std::uint32_t, 27> around{};
   SlotBits<kEdgeSlots> owned;
   std::uint32_t edge_vertices = 0;
   std::uint64_t cells = 0;
   std::uint32_t extra = 0;
 };
 
-void process_brick(const NarrowBand& band, std::uint32_t b, double iso, CellTile& t,
+// Per-thread scratch: the tile and its edge crossings.
+struct Scratch {
+  CellTile tile;
+  EdgeCrossings edges;
+};
+
+void process_brick(const NarrowBand& band, std::uint32_t b, double iso, Scratch& scratch,
                    BrickOut& out) {
+  CellTile& t = scratch.tile;
   gather_cell_tile(band, b, t);
+  out.around = t.around;
   const Coord base = brick_origin(band.bricks()[b].coord);
   const double h = band.voxel_size();
-  const Vec3d org = band.origin();
+  const Vec3d corner = band.origin() + Vec3d{double(base.x), double(base.y), double(base.z)} * h;
   ValidCells valid;
   valid.compute(t, iso);
+  out.vertices.reserve(valid.mixed_cells + 8);
+  out.normals.reserve(valid.mixed_cells + 8);
+  out.triangles.reserve(2 * valid.mixed_cells + 8);
 
-  // Owned edge vertices.
+  // Edge crossings of the cells [0, 8)^3, and the vertices of the owned ones in slot order.
+  scratch.edges.compute(t, valid, iso, 0);
   for (int z = 0; z < kBrickDim; ++z)
     for (int y = 0; y < kBrickDim; ++y) {
       std::uint32_t cr[3];
       valid.crossing_edges(y, z, cr);
-      for (std::uint32_t bits = cr[0] | cr[1] | cr[2]; bits != 0; bits &= bits - 1) {
-        const int x = std::countr_zero(bits);
+      for (std::uint32_t bits = (cr[0] | cr[1] | cr[2]) & ValidCells::x_bits(0, kBrickDim); bits != 0; bits &= bits - 1) {
+        const int x = std::countr_zero(bits) - 1;
+        const int p = CellTile::index(x, y, z);
         for (int a = 0; a < 3; ++a) {
-          if (!((cr[a] >> x) & 1u)) continue;
-          if (!valid.edge_used(x, y, z, a)) continue;
+          if (!((cr[a] >> (x + 1)) & 1u) || !valid.edge_used(x, y, z, a)) continue;
           out.owned.set(3 * local_index(x, y, z) + a);
-          const EdgePoint e = edge_point(t, x, y, z, a, iso);
-          out.vertices.push_back(org + (Vec3d{double(base.x), double(base.y), double(base.z)} + e.local) * h);
-          out.normals.push_back(e.normal);
+          const double s = scratch.edges.at(p, a);
+          out.vertices.push_back(corner + scratch.edges.point(x, y, z, a) * h);
+          out.normals.push_back(normalized_f(corner_gradient(t, p) * (1.0 - s) + corner_gradient(t, p + kTileStride[a]) * s));
         }
       }
     }
@@ -63,7 +75,7 @@ void process_brick(const NarrowBand& band, std::uint32_t b, double iso, CellTile
 
   // Cells.
   std::array<Vec3d, 12> pos;
-  std::array<std::uint64_t, 12> key;
+  std::array<VertexKey, 12> key;
   for (int z = 0; z < kBrickDim; ++z)
     for (int y = 0; y < kBrickDim; ++y)
       for (std::uint32_t bits = (valid.mixed_row(y, z) >> ValidCells::kH) & 0xffu; bits != 0; bits &= bits - 1) {
@@ -78,30 +90,30 @@ void process_brick(const NarrowBand& band, std::uint32_t b, double iso, CellTile
         const cell::LoopSet& ls = cell::loops_for(m, d);
         for (int l = 0; l < ls.loop_count; ++l) {
           const int n = ls.length[l];
+          const std::uint8_t* edges = &ls.edges[ls.begin[l]];
           for (int i = 0; i < n; ++i) {
-            const int e = ls.edges[ls.begin[l] + i];
+            const int e = edges[i];
             const int c = cell::edge_lower_corner(e);
             const int ex = x + (c & 1), ey = y + ((c >> 1) & 1), ez = z + ((c >> 2) & 1);
-            const int ax = e >> 2;
-            pos[i] = edge_point_position(t, ex, ey, ez, ax, iso);
-            const int owner = CellTile::neighbor_slot(ex >> 3, ey >> 3, ez >> 3);
-            key[i] = (std::uint64_t(t.around[owner]) << kSlotBits) |
-                     std::uint64_t(3 * local_index(ex & 7, ey & 7, ez & 7) + ax);
+            key[i] = vertex_key(CellTile::neighbor_slot(ex >> 3, ey >> 3, ez >> 3),
+                                3 * local_index(ex & 7, ey & 7, ez & 7) + (e >> 2));
           }
           if (n == 3) {
             out.triangles.push_back({key[0], key[1], key[2]});
             continue;
           }
+          for (int i = 0; i < n; ++i) {
+            const int e = edges[i];
+            const int c = cell::edge_lower_corner(e);
+            pos[i] = scratch.edges.point(x + (c & 1), y + ((c >> 1) & 1), z + ((c >> 2) & 1), e >> 2);
+          }
           if ((ls.doubled_face_loops >> l) & 1) {
             Vec3d c{};
-            Vec3f nrm{};
             for (int i = 0; i < n; ++i) c += pos[i];
             c = c / double(n);
-            const Vec3d g = gradient_at(t, c, x, y, z);
-            nrm = normalized_f(g);
-            const std::uint64_t ck = (std::uint64_t(b) << kSlotBits) | std::uint64_t(kEdgeSlots + out.extra);
-            out.vertices.push_back(org + (Vec3d{double(base.x), double(base.y), double(base.z)} + c) * h);
-            out.normals.push_back(nrm);
+            const VertexKey ck = vertex_key(CellTile::neighbor_slot(0, 0, 0), kEdgeSlots + int(out.extra));
+            out.vertices.push_back(corner + c * h);
+            out.normals.push_back(normalized_f(gradient_at(t, c, x, y, z)));
             ++out.extra;
             for (int i = 0; i < n; ++i) out.triangles.push_back({ck, key[i], key[(i + 1) % n]});
             continue;
@@ -120,17 +132,16 @@ SurfaceResult marching_cubes(const NarrowBand& band, const MarchingCubesOptions&
   check_iso(band, options.iso, "marching_cubes");
   const std::uint32_t nb = std::uint32_t(band.brick_count());
   std::vector<BrickOut> outs(nb);
-  tbb::enumerable_thread_specific<CellTile> tiles;
+  const std::vector<std::uint8_t> work = bricks_with_crossings(band, options.iso);
+  tbb::enumerable_thread_specific<Scratch> scratch;
   for_brick_batches(nb, options.progress, "marching_cubes", [&](std::uint32_t b) {
-    process_brick(band, b, options.iso, tiles.local(), outs[b]);
+    if (work[b]) process_brick(band, b, options.iso, scratch.local(), outs[b]);
   });
 
   SurfaceResult r;
   for (const BrickOut& o : outs) r.extra_vertices += o.extra;
   const MergeOffsets m = merge_offsets(outs, r, "marching_cubes");
-  auto remap = [&](std::uint64_t k) {
-    const std::uint32_t owner = std::uint32_t(k >> kSlotBits);
-    const int slot = int(k & ((1u << kSlotBits) - 1));
+  auto remap = [&](std::uint32_t owner, int slot) {
     const BrickOut& o = outs[owner];
     return slot < kEdgeSlots ? m.vertex[owner] + o.owned.rank(slot)
                              : m.vertex[owner] + o.edge_vertices + std::uint32_t(slot - kEdgeSlots);

@@ -1,6 +1,7 @@
 #include "surface/surface_common.hpp"
 
 #include <algorithm>
+#include <bit>
 #include <string>
 
 #include <tbb/blocked_range.h>
@@ -14,6 +15,38 @@ void check_iso(const NarrowBand& band, double iso, std::string_view where) {
   if (!std::isfinite(iso) || !(std::abs(iso) < double(band.background())))
     throw Error(ErrorCode::InvalidArgument, std::string(where),
                 "iso must be finite with |iso| < the band limit " + std::to_string(band.background()));
+}
+
+std::vector<std::uint8_t> bricks_with_crossings(const NarrowBand& band, double iso) {
+  const std::size_t nb = band.brick_count();
+  // Bit 0: some active value < iso; bit 1: some active value >= iso.
+  std::vector<std::uint8_t> sides(nb), work(nb);
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, nb, 256), [&](const tbb::blocked_range<std::size_t>& r) {
+    for (std::size_t b = r.begin(); b != r.end(); ++b) {
+      const std::span<const float> v = band.brick_values(std::uint32_t(b));
+      bool below = false, above = false;
+      for (const float x : v) {
+        below |= double(x) < iso;
+        above |= !(double(x) < iso);
+      }
+      sides[b] = std::uint8_t((below ? 1 : 0) | (above ? 2 : 0));
+    }
+  });
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, nb, 256), [&](const tbb::blocked_range<std::size_t>& r) {
+    for (std::size_t b = r.begin(); b != r.end(); ++b) {
+      std::uint8_t s = 0;
+      for (int d = 0; d < 8 && s != 3; ++d) {
+        std::uint32_t cur = std::uint32_t(b);
+        for (int a = 0; a < 3 && cur != kNoBrick; ++a)
+          if ((d >> a) & 1) cur = band.neighbor(cur, Face(2 * a + 1));
+        if (cur == kNoBrick && std::popcount(unsigned(d)) > 1)
+          cur = band.find_brick(band.bricks()[b].coord + Coord{d & 1, (d >> 1) & 1, (d >> 2) & 1});
+        if (cur != kNoBrick) s |= sides[cur];
+      }
+      work[b] = s == 3 ? 1 : 0;
+    }
+  });
+  return work;
 }
 
 void for_brick_batches(std::uint32_t bricks, const ProgressHook& progress, std::string_view stage,

@@ -9,9 +9,14 @@
 #include <cmath>
 #include <cstdint>
 #include <functional>
+#include <limits>
 #include <string>
 #include <string_view>
 #include <vector>
+
+#if defined(__SSE2__)
+#include <immintrin.h>
+#endif
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
@@ -42,18 +47,26 @@ struct ValidCells {
   std::array<std::uint32_t, CellTile::kDim * CellTile::kDim> active_rows{}, inside_rows{};
   // Per cell row (y, z) in [-1, 8)^2: valid cells and valid cells crossing iso (bit x + kHalo).
   std::array<std::uint32_t, kN * kN> valid_rows{}, mixed_rows{};
+  int mixed_cells = 0;  // cells in [0, 8)^3 that are valid and cross iso
   void compute(const CellTile& t, double iso = 0.0) {
-    for (int z = -kH; z < kBrickDim + kH; ++z)
-      for (int y = -kH; y < kBrickDim + kH; ++y) {
-        const int p = CellTile::index(-kH, y, z);
-        std::uint32_t act = 0, ins = 0;
-        for (int x = 0; x < CellTile::kDim; ++x) {
-          act |= std::uint32_t(t.active[p + x] != 0) << x;
-          ins |= std::uint32_t(double(t.values[p + x]) < iso) << x;
-        }
-        active_rows[row(y, z)] = act;
-        inside_rows[row(y, z)] = ins;
-      }
+    mixed_cells = 0;
+    active_rows = t.active_rows;
+    // double(v) < iso  <=>  v < below, the smallest float not below iso.
+    float below = float(iso);
+    if (double(below) < iso) below = std::nextafter(below, std::numeric_limits<float>::infinity());
+    static_assert(CellTile::kDim % 4 == 0);
+    for (int r = 0; r < CellTile::kDim * CellTile::kDim; ++r) {
+      const float* v = &t.values[std::size_t(r) * CellTile::kDim];
+      std::uint32_t ins = 0;
+#if defined(__SSE2__)
+      const __m128 lim = _mm_set1_ps(below);
+      for (int x = 0; x < CellTile::kDim; x += 4)
+        ins |= std::uint32_t(_mm_movemask_ps(_mm_cmplt_ps(_mm_loadu_ps(v + x), lim))) << x;
+#else
+      for (int x = 0; x < CellTile::kDim; ++x) ins |= std::uint32_t(v[x] < below) << x;
+#endif
+      inside_rows[r] = ins;
+    }
     constexpr std::uint32_t kCellBits = ((1u << kN) - 1) << (kH - 1);  // x in [-1, 8)
     for (int z = -1; z < kBrickDim; ++z)
       for (int y = -1; y < kBrickDim; ++y) {
@@ -70,20 +83,23 @@ struct ValidCells {
         const int cr = (y + 1) + kN * (z + 1);
         valid_rows[cr] = v;
         mixed_rows[cr] = v & o & ~n;
+        if (y >= 0 && z >= 0) mixed_cells += std::popcount((mixed_rows[cr] >> kH) & 0xffu);
         for (int x = -1; x < kBrickDim; ++x) flags[index(x, y, z)] = std::uint8_t((v >> (x + kH)) & 1u);
       }
   }
   std::uint32_t mixed_row(int y, int z) const { return mixed_rows[(y + 1) + kN * (z + 1)]; }
-  // Grid edges from (x, y, z), x in [0, 8), along axis a whose both ends are active and lie on
-  // opposite sides of iso: bit x of c[a].
+  // Grid edges from (x, y, z), x in [-1, 9), along axis a whose both ends are active and lie on
+  // opposite sides of iso: bit x + 1 of c[a]. Rows y, z in [-1, 9].
   void crossing_edges(int y, int z, std::uint32_t c[3]) const {
     const int r = row(y, z);
     const std::uint32_t act = active_rows[r], ins = inside_rows[r];
     const int nb[3] = {0, r + 1, r + CellTile::kDim};
     c[0] = act & (act >> 1) & (ins ^ (ins >> 1));
     for (int a = 1; a < 3; ++a) c[a] = act & active_rows[nb[a]] & (ins ^ inside_rows[nb[a]]);
-    for (int a = 0; a < 3; ++a) c[a] = (c[a] >> kH) & 0xffu;
+    for (int a = 0; a < 3; ++a) c[a] = (c[a] >> (kH - 1)) & 0x3ffu;
   }
+  // Bits of crossing_edges for x in [lo, hi).
+  static constexpr std::uint32_t x_bits(int lo, int hi) { return ((1u << (hi + 1)) - 1u) & ~((1u << (lo + 1)) - 1u); }
   // Any of the 4 cells around the edge from (x,y,z) along axis a is valid.
   bool edge_used(int x, int y, int z, int a) const {
     const int b = a == 0 ? 1 : 0, c = a == 2 ? 1 : 2;
@@ -95,6 +111,36 @@ struct ValidCells {
         if (at(p[0], p[1], p[2])) return true;
       }
     return false;
+  }
+};
+
+// Edge crossings of one tile: the parameter s in [0, 1] of the iso crossing on the edge from
+// tile voxel p along axis a, computed once per edge (one division) for every crossing edge
+// whose lower end lies in [lo, 9)^3. Other entries are stale.
+struct EdgeCrossings {
+  std::vector<double> s = std::vector<double>(3 * CellTile::kSize);
+  void compute(const CellTile& t, const ValidCells& v, double iso, int lo) {
+    for (int z = lo; z <= kBrickDim; ++z)
+      for (int y = lo; y <= kBrickDim; ++y) {
+        std::uint32_t cr[3];
+        v.crossing_edges(y, z, cr);
+        for (std::uint32_t bits = (cr[0] | cr[1] | cr[2]) & ValidCells::x_bits(lo, kBrickDim + 1); bits != 0;
+             bits &= bits - 1) {
+          const int x = std::countr_zero(bits) - 1;
+          const int p = CellTile::index(x, y, z);
+          for (int a = 0; a < 3; ++a) {
+            if (!((cr[a] >> (x + 1)) & 1u)) continue;
+            const double ap = double(t.values[p]) - iso, aq = double(t.values[p + kTileStride[a]]) - iso;
+            s[std::size_t(3 * p + a)] = ap / (ap - aq);
+          }
+        }
+      }
+  }
+  double at(int p, int a) const { return s[std::size_t(3 * p + a)]; }
+  // Tile-local point of the crossing on the edge from (x, y, z) along a.
+  Vec3d point(int x, int y, int z, int a) const {
+    const double s = at(CellTile::index(x, y, z), a);
+    return {double(x) + (a == 0 ? s : 0.0), double(y) + (a == 1 ? s : 0.0), double(z) + (a == 2 ? s : 0.0)};
   }
 };
 
@@ -118,12 +164,35 @@ struct SlotBits {
   }
 };
 
-inline Vec3d corner_gradient(const CellTile& t, int p) {
-  const float* v = t.values.data();
-  return {0.5 * (double(v[p + kTileStride[0]]) - double(v[p - kTileStride[0]])),
-          0.5 * (double(v[p + kTileStride[1]]) - double(v[p - kTileStride[1]])),
-          0.5 * (double(v[p + kTileStride[2]]) - double(v[p - kTileStride[2]]))};
-}
+// Central-difference gradients of a tile at the corners of the cells [lo, 8)^3 that cross iso
+// (voxel rows holding such corners only), in value units per voxel, computed row by row
+// (vectorised) once per brick. Entries of other voxels are stale.
+struct GradientTile {
+  std::vector<float> g[3] = {std::vector<float>(CellTile::kSize), std::vector<float>(CellTile::kSize),
+                             std::vector<float>(CellTile::kSize)};
+  void compute(const CellTile& t, const ValidCells& valid, int lo) {
+    constexpr int kRows = kBrickDim + 2;  // voxel rows y, z in [-1, 9)
+    std::array<std::uint16_t, kRows> need{};  // bit y + 1 of need[z + 1]
+    for (int z = lo; z < kBrickDim; ++z)
+      for (int y = lo; y < kBrickDim; ++y)
+        if (valid.mixed_row(y, z) & ValidCells::x_bits(lo, kBrickDim) << 1) {
+          const std::uint16_t two = std::uint16_t(3u << (y + 1));
+          need[std::size_t(z + 1)] |= two;
+          need[std::size_t(z + 2)] |= two;
+        }
+    const float* __restrict v = t.values.data();
+    for (int z = lo; z <= kBrickDim; ++z)
+      for (std::uint32_t ys = need[std::size_t(z + 1)]; ys != 0; ys &= ys - 1) {
+        const int y = std::countr_zero(ys) - 1;
+        const int p = CellTile::index(-1, y, z);
+        for (int a = 0; a < 3; ++a) {
+          const int st = kTileStride[a];
+          float* __restrict out = g[a].data() + p;
+          for (int x = 0; x < kBrickDim + 2; ++x) out[x] = 0.5f * (v[p + x + st] - v[p + x - st]);
+        }
+      }
+  }
+};
 
 inline Vec3f normalized_f(const Vec3d& g) {
   const double l = length(g);
@@ -131,32 +200,12 @@ inline Vec3f normalized_f(const Vec3d& g) {
   return {float(g.x / l), float(g.y / l), float(g.z / l)};
 }
 
-inline double edge_parameter(const CellTile& t, int p, int q, double iso) {
-  const double ap = double(t.values[p]) - iso, aq = double(t.values[q]) - iso;
-  return ap / (ap - aq);
-}
-
-inline Vec3d edge_point_position(const CellTile& t, int x, int y, int z, int a, double iso) {
-  const int p = CellTile::index(x, y, z);
-  const double s = edge_parameter(t, p, p + kTileStride[a], iso);
-  Vec3d r{double(x), double(y), double(z)};
-  r[a] += s;
-  return r;
-}
-
-struct EdgePoint {
-  Vec3d local;
-  Vec3f normal;
-};
-
-inline EdgePoint edge_point(const CellTile& t, int x, int y, int z, int a, double iso) {
-  const int p = CellTile::index(x, y, z), q = p + kTileStride[a];
-  const double s = edge_parameter(t, p, q, iso);
-  EdgePoint e;
-  e.local = {double(x), double(y), double(z)};
-  e.local[a] += s;
-  e.normal = normalized_f(corner_gradient(t, p) * (1.0 - s) + corner_gradient(t, q) * s);
-  return e;
+// Central-difference gradient at tile voxel p (value units per voxel).
+inline Vec3d corner_gradient(const CellTile& t, int p) {
+  const float* v = t.values.data();
+  return {0.5 * (double(v[p + kTileStride[0]]) - double(v[p - kTileStride[0]])),
+          0.5 * (double(v[p + kTileStride[1]]) - double(v[p - kTileStride[1]])),
+          0.5 * (double(v[p + kTileStride[2]]) - double(v[p - kTileStride[2]]))};
 }
 
 // Level set gradient at local point c inside cell (x,y,z): trilinear blend of the corner
@@ -172,31 +221,43 @@ inline Vec3d gradient_at(const CellTile& t, const Vec3d& c, int x, int y, int z)
   return g;
 }
 
-// Largest cosine of the three angles of a triangle (1 when degenerate).
-inline double max_cos(const Vec3d& a, const Vec3d& b, const Vec3d& c) {
-  const Vec3d ab = b - a, bc = c - b, ca = a - c;
-  const double lab = length(ab), lbc = length(bc), lca = length(ca);
-  if (!(lab > 0 && lbc > 0 && lca > 0)) return 1.0;
-  const double c1 = -dot(ab, ca) / (lab * lca), c2 = -dot(ab, bc) / (lab * lbc),
-               c3 = -dot(bc, ca) / (lbc * lca);
-  return std::max(c1, std::max(c2, c3));
+// Cosine of the smallest angle of a triangle with squared side lengths a2 <= ... (any order):
+// the smallest angle faces the shortest side (law of cosines). 1 when degenerate.
+inline double max_cos_from_squares(double a2, double b2, double c2) {
+  if (b2 < a2) std::swap(a2, b2);
+  if (c2 < a2) std::swap(a2, c2);
+  const double bc = b2 * c2;
+  if (!(a2 > 0.0 && bc > 0.0)) return 1.0;
+  return (b2 + c2 - a2) / (2.0 * std::sqrt(bc));
 }
 
-// Fan apex for a polygon of n >= 4 vertices that maximises the smallest angle.
+// Quad p0 p1 p2 p3: true when the diagonal p0-p2 is the Delaunay one (the angles at p1 and p3
+// facing it sum to at most pi: cot a1 + cot a3 >= 0), which for a planar convex quad is the
+// split that maximises the smallest angle. Two square roots, no division.
+inline bool split_02(const Vec3d* p) {
+  const Vec3d u1 = p[0] - p[1], v1 = p[2] - p[1], u3 = p[0] - p[3], v3 = p[2] - p[3];
+  const double s1 = length(cross(u1, v1)), s3 = length(cross(u3, v3));
+  return dot(u1, v1) * s3 + dot(u3, v3) * s1 >= 0.0;
+}
+
+// Fan apex for a polygon of n in [4, 12] vertices that maximises the smallest angle (quads:
+// the Delaunay diagonal, fan from 0 or 1). Squared distances are computed once per pair.
 inline int best_fan_start(const Vec3d* p, int n) {
-  if (n == 4) {
-    // Fans at 2 and 3 repeat the triangles of fans 0 and 1 (max_cos is invariant under cyclic
-    // rotation), and ties keep the earliest start: same answer as the general loop.
-    const double w0 = std::max(max_cos(p[0], p[1], p[2]), max_cos(p[0], p[2], p[3]));
-    const double w1 = std::max(max_cos(p[1], p[2], p[3]), max_cos(p[1], p[3], p[0]));
-    return w1 < w0 ? 1 : 0;
-  }
+  if (n == 4) return split_02(p) ? 0 : 1;
+  double d2[12][12];
+  for (int i = 0; i < n; ++i)
+    for (int j = i + 1; j < n; ++j) {
+      const Vec3d e = p[j] - p[i];
+      d2[i][j] = d2[j][i] = dot(e, e);
+    }
   int best = 0;
   double best_cos = 2.0;
   for (int s = 0; s < n; ++s) {
     double worst = -2.0;
-    for (int i = 1; i + 1 < n; ++i)
-      worst = std::max(worst, max_cos(p[s], p[(s + i) % n], p[(s + i + 1) % n]));
+    for (int i = 1; i + 1 < n; ++i) {
+      const int b = (s + i) % n, c = (s + i + 1) % n;
+      worst = std::max(worst, max_cos_from_squares(d2[s][b], d2[b][c], d2[c][s]));
+    }
     if (worst < best_cos) {
       best_cos = worst;
       best = s;
@@ -207,14 +268,30 @@ inline int best_fan_start(const Vec3d* p, int n) {
 
 void check_iso(const NarrowBand& band, double iso, std::string_view where);
 
+// Which bricks can own output at iso: a brick owns the cells and grid edges whose lowest voxel
+// lies in it, so it has work only when the active values of itself and its 7 upper neighbours
+// (+x, +y, +z and their combinations) lie on both sides of iso. One pass over the values.
+std::vector<std::uint8_t> bricks_with_crossings(const NarrowBand& band, double iso);
+
 // f(brick) for every brick: TBB inside batches, progress.step between batches (serial).
 void for_brick_batches(std::uint32_t bricks, const ProgressHook& progress, std::string_view stage,
                        const std::function<void(std::uint32_t)>& f);
 
+// Vertex keys of the per-brick outputs: the owning brick as its slot in the emitting brick's
+// 3x3x3 neighbourhood (CellTile::neighbor_slot, 5 bits) and the vertex slot in that brick.
+inline constexpr int kKeySlotBits = 12;
+using VertexKey = std::uint32_t;
+inline VertexKey vertex_key(int neighbor_slot, int slot) {
+  return VertexKey(neighbor_slot) << kKeySlotBits | VertexKey(slot);
+}
+inline int key_neighbor(VertexKey k) { return int(k >> kKeySlotBits); }
+inline int key_slot(VertexKey k) { return int(k & ((1u << kKeySlotBits) - 1)); }
+
 // Concatenation of per-brick outputs in brick order, shared by both extractors. Out needs
-// `vertices`, `normals`, `triangles` (3 brick-local keys each), `owned` (finish()) and `cells`.
-// merge_offsets sizes the result and returns each brick's first vertex and triangle;
-// copy_merged fills it in parallel, mapping keys to global indices with remap(key).
+// `vertices`, `normals`, `triangles` (3 VertexKeys each), `around` (the neighbourhood the keys
+// refer to), `owned` (finish()) and `cells`. merge_offsets sizes the result and returns each
+// brick's first vertex and triangle; copy_merged fills it in parallel, mapping keys to global
+// indices with remap(owner brick, slot).
 struct MergeOffsets {
   std::vector<std::uint32_t> vertex;    // first vertex of each brick (bricks + 1 entries)
   std::vector<std::uint64_t> triangle;  // first triangle of each brick (bricks + 1 entries)
@@ -251,7 +328,8 @@ void copy_merged(const std::vector<Out>& outs, const MergeOffsets& m, Remap&& re
       std::copy(o.normals.begin(), o.normals.end(), r.normals.begin() + m.vertex[b]);
       for (std::size_t i = 0; i < o.triangles.size(); ++i) {
         const auto& k = o.triangles[i];
-        r.mesh.triangles[m.triangle[b] + i] = {remap(k[0]), remap(k[1]), remap(k[2])};
+        auto global = [&](VertexKey key) { return remap(o.around[std::size_t(key_neighbor(key))], key_slot(key)); };
+        r.mesh.triangles[m.triangle[b] + i] = {global(k[0]), global(k[1]), global(k[2])};
       }
     }
   });

@@ -89,17 +89,27 @@ TEST_P(TileTest, GatherMatchesAccessorIncludingHalo) {
   const auto sb = make_shape_band("torus", 48);
   const NarrowBand& band = sb.band;
   const TileShape shape{halo};
-  std::vector<float> tile(shape.size());
+  std::vector<float> tile(shape.size()), tile2(shape.size());
+  const std::size_t dim = std::size_t(shape.dim());
+  std::vector<std::uint32_t> rows(dim * dim);
   BandAccessor acc(band);
   for (std::uint32_t b = 0; b < band.brick_count(); ++b) {
     gather_tile(band, b, halo, tile);
+    gather_tile(band, b, halo, tile2, rows);
+    ASSERT_EQ(tile, tile2);
     const Coord o = brick_origin(band.bricks()[b].coord);
     for (int z = -halo; z < kBrickDim + halo; ++z)
       for (int y = -halo; y < kBrickDim + halo; ++y)
-        for (int x = -halo; x < kBrickDim + halo; ++x)
-          ASSERT_EQ(tile[shape.index(x, y, z)], acc.value(o + Coord{x, y, z}))
-              << "brick " << b << " at " << x << "," << y << "," << z;
+        for (int x = -halo; x < kBrickDim + halo; ++x) {
+          const Coord c = o + Coord{x, y, z};
+          ASSERT_EQ(tile[shape.index(x, y, z)], acc.value(c)) << "brick " << b << " at " << x << "," << y << "," << z;
+          const std::uint32_t row = rows[std::size_t(y + halo) + dim * std::size_t(z + halo)];
+          ASSERT_EQ(((row >> (x + halo)) & 1u) != 0, band.is_active(c))
+              << "active bit, brick " << b << " at " << x << "," << y << "," << z;
+        }
   }
+  std::vector<std::uint32_t> wrong(dim * dim + 1);
+  EXPECT_THROW(gather_tile(band, 0, halo, tile, wrong), Error);
 }
 
 INSTANTIATE_TEST_SUITE_P(Halos, TileTest, ::testing::Values(0, 1, 2, 3, 8));

@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <cstring>
+#include <limits>
 #include <filesystem>
 #include <random>
 
@@ -82,6 +83,37 @@ TEST(ClosestPointTransform, BoxMeshGivesTheAnalyticBoxDistance) {
     const double sdf = length(max(q, Vec3d{0, 0, 0})) + std::min(std::max(q.x, std::max(q.y, q.z)), 0.0);
     ASSERT_NEAR(v, sdf, 1e-5 * r.band.voxel_size());
   });
+}
+
+// Faces exactly on voxel planes (CGAL's corner.off case): voxels on the surface have distance
+// 0, and their sign must come from the inside mask, never -0 (which reads as outside) nor a
+// sign left to the rounding of the distance: all voxels on one planar face agree.
+TEST(ClosestPointTransform, FacesOnVoxelPlanesGetOneSignPerFace) {
+  const double h = 0.125;
+  const Vec3d lo{0.5, 0.5, 0.5}, hi{2.0, 1.0, 1.5};
+  CptOptions options;
+  options.frame = GridFrame{h, Vec3d{0.0, 0.0, 0.0}, 3.0};
+  const CptResult r = closest_point_transform(box_mesh(lo, hi), options);
+  std::size_t on_face[6][2] = {};  // [face][negative]
+  r.band.for_each_active_world([&](const Coord&, const Vec3d& p, float v) {
+    ASSERT_FALSE(v == 0.0f && std::signbit(v)) << "-0 at " << p.x << " " << p.y << " " << p.z;
+    if (std::abs(v) > std::numeric_limits<float>::min()) return;
+    for (int a = 0; a < 3; ++a) {
+      const bool in_face = [&] {
+        for (int b = 0; b < 3; ++b)
+          if (b != a && (p[b] <= lo[b] || p[b] >= hi[b])) return false;  // face interiors only
+        return true;
+      }();
+      if (!in_face) continue;
+      if (p[a] == lo[a]) ++on_face[2 * a][v < 0.0f];
+      if (p[a] == hi[a]) ++on_face[2 * a + 1][v < 0.0f];
+    }
+  });
+  for (int f = 0; f < 6; ++f) {
+    EXPECT_GT(on_face[f][0] + on_face[f][1], 10u) << "face " << f << " is not on a voxel plane";
+    EXPECT_TRUE(on_face[f][0] == 0 || on_face[f][1] == 0)
+        << "face " << f << ": " << on_face[f][0] << " voxels outside, " << on_face[f][1] << " inside";
+  }
 }
 
 TEST(ClosestPointTransform, SphereMeshWithinItsOwnApproximationError) {
