@@ -1,6 +1,7 @@
 #include "grid/tile.hpp"
 
 #include <algorithm>
+#include <array>
 #include <bit>
 #include <string>
 
@@ -21,6 +22,21 @@ std::uint32_t neighbor_at(const NarrowBand& band, std::uint32_t b, const Coord& 
   if (cur == kNoBrick && axes > 1) cur = band.find_brick(band.bricks()[b].coord + d);
   return cur;
 }
+
+// kActiveBefore[m], nibble x: the number of set bits of the byte m below bit x.
+constexpr std::array<std::uint32_t, 256> make_active_before() {
+  std::array<std::uint32_t, 256> t{};
+  for (std::uint32_t m = 0; m < 256; ++m) {
+    std::uint32_t acc = 0, packed = 0;
+    for (int x = 0; x < 8; ++x) {
+      packed |= acc << (4 * x);
+      acc += (m >> x) & 1u;
+    }
+    t[m] = packed;
+  }
+  return t;
+}
+constexpr std::array<std::uint32_t, 256> kActiveBefore = make_active_before();
 
 }  // namespace
 
@@ -44,65 +60,79 @@ void gather_tile(const NarrowBand& band, std::uint32_t brick, int halo, std::spa
                  std::span<std::uint32_t> active_rows) {
   if (halo < 0 || halo > kBrickDim)
     throw Error(ErrorCode::InvalidArgument, "gather_tile", "halo must be in [0, 8]");
-  const TileShape shape{halo};
-  const int dim = shape.dim();
-  if (out.size() != shape.size())
-    throw Error(ErrorCode::InvalidArgument, "gather_tile", "output size does not match halo");
+  gather_box(band, brick, -halo, kBrickDim + halo, out, active_rows);
+}
+
+void gather_box(const NarrowBand& band, std::uint32_t brick, int lo, int hi, std::span<float> out,
+                std::span<std::uint32_t> active_rows) {
+  if (lo < -kBrickDim || lo > 0 || hi < kBrickDim || hi > 2 * kBrickDim)
+    throw Error(ErrorCode::InvalidArgument, "gather_box", "need -8 <= lo <= 0 and 8 <= hi <= 16");
+  const std::size_t dim = std::size_t(hi - lo);
+  if (out.size() != dim * dim * dim)
+    throw Error(ErrorCode::InvalidArgument, "gather_box", "output size must be (hi - lo)^3");
   const bool rows = !active_rows.empty();
-  if (rows && active_rows.size() != std::size_t(dim) * std::size_t(dim))
-    throw Error(ErrorCode::InvalidArgument, "gather_tile", "active_rows size must be dim^2");
+  if (rows && active_rows.size() != dim * dim)
+    throw Error(ErrorCode::InvalidArgument, "gather_box", "active_rows size must be (hi - lo)^2");
   if (rows) std::fill(active_rows.begin(), active_rows.end(), 0u);
   const float bg = band.background();
+  const float sign_value[2] = {bg, -bg};  // by inside bit
   const Coord self = band.bricks()[brick].coord;
   const float* all_values = band.values().data();
+  // Box index of local voxel (x, y, z).
+  auto index = [&](int x, int y, int z) {
+    return std::size_t(x - lo) + dim * (std::size_t(y - lo) + dim * std::size_t(z - lo));
+  };
   for (int dz = -1; dz <= 1; ++dz) {
     for (int dy = -1; dy <= 1; ++dy) {
       for (int dx = -1; dx <= 1; ++dx) {
         const Coord d{dx, dy, dz};
-        // Local range of the neighbour that falls into the tile, per axis.
-        int lo[3], hi[3];
+        // Local range of the neighbour that falls into the box, per axis.
+        int nlo[3], nhi[3];
         bool empty = false;
         for (int a = 0; a < 3; ++a) {
-          lo[a] = d[a] < 0 ? kBrickDim - halo : 0;
-          hi[a] = d[a] > 0 ? halo : kBrickDim;
-          if (d[a] != 0 && halo == 0) empty = true;
+          nlo[a] = d[a] < 0 ? kBrickDim + lo : 0;
+          nhi[a] = d[a] > 0 ? hi - kBrickDim : kBrickDim;
+          empty |= nlo[a] >= nhi[a];
         }
         if (empty) continue;
         const std::uint32_t nb = (dx | dy | dz) == 0 ? brick : neighbor_at(band, brick, d);
-        const int width = hi[0] - lo[0];
+        const int width = nhi[0] - nlo[0];
         if (nb == kNoBrick) {
           // Unallocated: one sign for the whole brick (band invariant).
-          const Coord probe = brick_origin(self + d) + Coord{lo[0], lo[1], lo[2]};
+          const Coord probe = brick_origin(self + d) + Coord{nlo[0], nlo[1], nlo[2]};
           const float v = band.is_inside_unallocated(probe) ? -bg : bg;
-          for (int z = lo[2]; z < hi[2]; ++z)
-            for (int y = lo[1]; y < hi[1]; ++y)
-              std::fill_n(&out[shape.index(lo[0] + dx * kBrickDim, y + dy * kBrickDim, z + dz * kBrickDim)], width, v);
+          for (int z = nlo[2]; z < nhi[2]; ++z)
+            for (int y = nlo[1]; y < nhi[1]; ++y)
+              std::fill_n(&out[index(nlo[0] + dx * kBrickDim, y + dy * kBrickDim, z + dz * kBrickDim)], width, v);
           continue;
         }
         // Row by row: a row of a brick is one byte of its masks, and its active values are
         // contiguous in the packed storage.
         const Brick& br = band.bricks()[nb];
         const float* vals = all_values + br.value_offset;
-        const std::uint32_t xmask = ((1u << hi[0]) - 1u) & ~((1u << lo[0]) - 1u);
-        const int shift = lo[0] + dx * kBrickDim + halo;  // tile bit of local x = lo[0]
-        for (int z = lo[2]; z < hi[2]; ++z) {
+        const std::uint32_t xmask = ((1u << nhi[0]) - 1u) & ~((1u << nlo[0]) - 1u);
+        const int shift = nlo[0] + dx * kBrickDim - lo;  // box bit of local x = nlo[0]
+        for (int z = nlo[2]; z < nhi[2]; ++z) {
           const std::uint64_t act_word = br.active.words[std::size_t(z)];
           const std::uint64_t ins_word = band.stored_inside_word(br, z);
           const int rank_z = br.rank_base(z);
-          for (int y = lo[1]; y < hi[1]; ++y) {
+          for (int y = nlo[1]; y < nhi[1]; ++y) {
             const int bit0 = 8 * y;
             const std::uint32_t act = std::uint32_t(act_word >> bit0) & 0xffu;
             const std::uint32_t ins = std::uint32_t(ins_word >> bit0) & 0xffu;
-            const std::size_t row = shape.index(0, y + dy * kBrickDim, z + dz * kBrickDim) - std::size_t(halo);
-            float* o = &out[row + std::size_t(dx * kBrickDim + halo)];
-            for (int x = lo[0]; x < hi[0]; ++x) o[x] = ((ins >> x) & 1u) ? -bg : bg;
-            const std::uint32_t take = act & xmask;
-            if (take != 0) {
-              int k = rank_z + std::popcount(act_word & ((std::uint64_t{1} << bit0) - 1)) +
-                      std::popcount(act & ((1u << lo[0]) - 1u));
-              for (std::uint32_t b = take; b != 0; b &= b - 1) o[std::countr_zero(b)] = vals[k++];
+            const std::size_t row = index(lo, y + dy * kBrickDim, z + dz * kBrickDim);
+            float* o = &out[row + std::size_t(dx * kBrickDim - lo)];
+            // Branch-free per voxel: the value's address is selected, not branched on (the
+            // active pattern of a row is unpredictable).
+            const float* row_values = vals + rank_z + std::popcount(act_word & ((std::uint64_t{1} << bit0) - 1));
+            const std::uint32_t before = kActiveBefore[act];
+            for (int x = nlo[0]; x < nhi[0]; ++x) {
+              const float* src = ((act >> x) & 1u) ? row_values + ((before >> (4 * x)) & 15u) : &sign_value[(ins >> x) & 1u];
+              o[x] = *src;
             }
-            if (rows) active_rows[row / std::size_t(dim)] |= (take >> lo[0]) << shift;
+            if (rows)
+              active_rows[std::size_t(y + dy * kBrickDim - lo) + dim * std::size_t(z + dz * kBrickDim - lo)] |=
+                  ((act & xmask) >> nlo[0]) << shift;
           }
         }
       }

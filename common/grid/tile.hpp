@@ -35,6 +35,13 @@ void gather_tile(const NarrowBand& band, std::uint32_t brick, int halo, std::spa
 void gather_tile(const NarrowBand& band, std::uint32_t brick, int halo, std::span<float> out,
                  std::span<std::uint32_t> active_rows);
 
+// The general form: the box [lo, hi)^3 of brick-local voxel coordinates (-8 <= lo <= 0,
+// 8 <= hi <= 16; dim = hi - lo), index (x-lo) + dim*((y-lo) + dim*(z-lo)); active_rows may be
+// empty, else it has dim^2 entries (bit x-lo of entry (y-lo) + dim*(z-lo)).
+// gather_tile(halo) is gather_box(-halo, 8 + halo).
+void gather_box(const NarrowBand& band, std::uint32_t brick, int lo, int hi, std::span<float> out,
+                std::span<std::uint32_t> active_rows);
+
 // Dense 512 values of one brick (halo 0) into out[local_index].
 void decode_brick(const NarrowBand& band, std::uint32_t brick, std::span<float, kBrickVoxels> out);
 

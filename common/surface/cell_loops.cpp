@@ -13,6 +13,30 @@ std::array<int, 4> face_corners(int f) {
 
 namespace {
 
+// Offset of edge e's lower corner along axis a (0 when a is the edge's own axis).
+int edge_offset(int e, int a) { return (edge_lower_corner(e) >> a) & 1; }
+
+}  // namespace
+
+int common_face(int e0, int e1) {
+  if (e0 == e1) return -1;
+  // A face normal to a holds every edge along the other two axes with its offset along a.
+  for (int a = 0; a < 3; ++a) {
+    if (a == (e0 >> 2) || a == (e1 >> 2)) continue;
+    if (edge_offset(e0, a) == edge_offset(e1, a)) return 2 * a + edge_offset(e0, a);
+  }
+  return -1;
+}
+
+int edge_from_lower_neighbor(int e, int a) {
+  const int lower = edge_lower_corner(e) | (1 << a);
+  for (int k = 0; k < 12; ++k)
+    if (edge_lower_corner(k) == lower && (k >> 2) == (e >> 2)) return k;
+  return -1;
+}
+
+namespace {
+
 int edge_between(int c0, int c1) {
   for (int e = 0; e < 12; ++e) {
     const int lo = edge_lower_corner(e), hi = edge_upper_corner(e);
@@ -27,7 +51,7 @@ LoopSet trace(int m, int decisions) {
   std::array<int, 12> next;
   next.fill(-1);
   // Which face holds both segments of a 4-crossing face: pairs of entry edges per face.
-  std::vector<std::array<int, 2>> doubled;
+  std::vector<std::array<int, 3>> doubled;  // entry edges and face
   for (int f = 0; f < 6; ++f) {
     std::array<int, 4> c = face_corners(f);
     // Counter-clockwise seen from outside the cell. The canonical order turns about +axis for
@@ -55,7 +79,7 @@ LoopSet trace(int m, int decisions) {
       continue;
     }
     const bool connected = (decisions >> f) & 1;
-    std::array<int, 2> pair{};
+    std::array<int, 3> pair{0, 0, f};
     int k = 0;
     for (int i = 0; i < 4; ++i) {
       if (in[i] || !in[(i + 1) & 3]) continue;
@@ -78,7 +102,10 @@ LoopSet trace(int m, int decisions) {
     s.length[l] = std::uint8_t(pos - s.begin[l]);
   }
   for (const auto& p : doubled)
-    if (s.loop_of_edge[p[0]] == s.loop_of_edge[p[1]]) s.doubled_face_loops |= std::uint8_t(1u << s.loop_of_edge[p[0]]);
+    if (s.loop_of_edge[p[0]] == s.loop_of_edge[p[1]]) {
+      s.doubled_face_loops |= std::uint8_t(1u << s.loop_of_edge[p[0]]);
+      s.doubled_faces[s.loop_of_edge[p[0]]] |= std::uint8_t(1u << p[2]);
+    }
   return s;
 }
 

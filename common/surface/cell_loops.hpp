@@ -40,7 +40,16 @@ struct LoopSet {
   // Bit l: loop l holds both segments of a face with 4 crossings (two of its vertices lie on
   // one face without a segment between them; a diagonal there could be shared by neighbours).
   std::uint8_t doubled_face_loops = 0;
+  // Per loop: bit f set when the loop holds both segments of face f.
+  std::array<std::uint8_t, 4> doubled_faces{};
 };
+
+// The face (2 * axis + side) holding both edges e0 and e1 of one cell, -1 if none.
+int common_face(int e0, int e1);
+
+// The grid edge e of a cell, seen from the neighbouring cell at -1 along axis a (e lies on the
+// cell's face 2a, i.e. its offset along a is 0): that cell's index for the same edge.
+int edge_from_lower_neighbor(int e, int a);
 
 // Loops for the inside mask (bit i: corner i inside) and face decisions (bit f: on face f,
 // when it has 4 crossings, the inside corners are connected across the face).

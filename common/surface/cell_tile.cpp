@@ -18,7 +18,8 @@ std::uint32_t neighbor_at(const NarrowBand& band, std::uint32_t b, const Coord& 
 }  // namespace
 
 void gather_cell_tile(const NarrowBand& band, std::uint32_t brick, CellTile& tile) {
-  gather_tile(band, brick, CellTile::kHalo, std::span<float>(tile.values), std::span<std::uint32_t>(tile.active_rows));
+  gather_box(band, brick, -CellTile::kHalo, CellTile::kDim - CellTile::kHalo,
+             std::span<float>(tile.values.data(), CellTile::kSize), std::span<std::uint32_t>(tile.active_rows));
   for (int dz = -1; dz <= 1; ++dz)
     for (int dy = -1; dy <= 1; ++dy)
       for (int dx = -1; dx <= 1; ++dx)

@@ -1,11 +1,14 @@
-// CellTile: one brick's values and active flags with a halo of 2, for the surface extractors.
+// CellTile: one brick's values and active flags with the halo the surface extractors need:
+// the box [-1, 10)^3 of brick-local voxels (cells [-1, 8)^3 with their corners, and central
+// differences at the corners [0, 9)^3).
 //
-// Inputs: a band and a brick index. Output: dense (8+4)^3 arrays (layout of grid/tile.hpp,
-// halo 2): values (+-background outside the band), active row bitmasks (bit x + kHalo of row
-// (y, z) where the band stores voxel (x, y, z)), and the indices of the brick and its 26 neighbours (around[neighbor_slot(d)] for
-// d in {-1,0,1}^3; kNoBrick where unallocated). Cost: O(12^3) plus up to 26 neighbour resolutions (face links,
-// a hash lookup only for a diagonal brick whose face path is unallocated). Threading: one
-// tile per thread; the band is read only.
+// Inputs: a band and a brick index. Output: dense 11^3 values (grid/tile.hpp gather_box layout,
+// +-background outside the band; 4 floats of padding at the end for vector loads), active row
+// bitmasks (bit x + kHalo of row (y, z) where the band stores voxel (x, y, z)), and the indices
+// of the brick and its 26 neighbours (around[neighbor_slot(d)] for d in {-1,0,1}^3; kNoBrick
+// where unallocated). Cost: O(11^3) plus up to 26 neighbour resolutions (face links, a hash
+// lookup only for a diagonal brick whose face path is unallocated). Threading: one tile per
+// thread; the band is read only.
 #pragma once
 
 #include <array>
@@ -17,13 +20,14 @@
 namespace levelset {
 
 struct CellTile {
-  static constexpr int kHalo = 2;
-  static constexpr int kDim = kBrickDim + 2 * kHalo;
+  static constexpr int kHalo = 1;  // below the brick; 2 above
+  static constexpr int kDim = kBrickDim + 3;
   static constexpr int kSize = kDim * kDim * kDim;
+  static constexpr int kPadding = 4;
   static constexpr int index(int x, int y, int z) {
     return (x + kHalo) + kDim * ((y + kHalo) + kDim * (z + kHalo));
   }
-  std::vector<float> values = std::vector<float>(kSize);
+  std::vector<float> values = std::vector<float>(kSize + kPadding);
   static constexpr int row(int y, int z) { return (y + kHalo) + kDim * (z + kHalo); }
   std::array<std::uint32_t, kDim * kDim> active_rows{};
   static constexpr int neighbor_slot(int dx, int dy, int dz) { return (dx + 1) + 3 * (dy + 1) + 9 * (dz + 1); }

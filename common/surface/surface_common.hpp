@@ -38,9 +38,8 @@ inline constexpr int kCornerOffset[8] = {
 // Cells with min corner in [-1, 8)^3 whose 8 corners are all active.
 struct ValidCells {
   static constexpr int kN = kBrickDim + 1;
-  std::array<std::uint8_t, kN * kN * kN> flags{};
   static int index(int x, int y, int z) { return (x + 1) + kN * ((y + 1) + kN * (z + 1)); }
-  bool at(int x, int y, int z) const { return flags[index(x, y, z)] != 0; }
+  bool at(int x, int y, int z) const { return (valid_rows[std::size_t((y + 1) + kN * (z + 1))] >> (x + kH)) & 1u; }
   // Row bitmasks over x (bit x + kHalo) for every tile row (y, z): active and inside (< iso).
   static constexpr int kH = CellTile::kHalo;
   static int row(int y, int z) { return (y + kH) + CellTile::kDim * (z + kH); }
@@ -54,14 +53,15 @@ struct ValidCells {
     // double(v) < iso  <=>  v < below, the smallest float not below iso.
     float below = float(iso);
     if (double(below) < iso) below = std::nextafter(below, std::numeric_limits<float>::infinity());
-    static_assert(CellTile::kDim % 4 == 0);
+    constexpr std::uint32_t kRowBits = (1u << CellTile::kDim) - 1;
     for (int r = 0; r < CellTile::kDim * CellTile::kDim; ++r) {
       const float* v = &t.values[std::size_t(r) * CellTile::kDim];
       std::uint32_t ins = 0;
 #if defined(__SSE2__)
       const __m128 lim = _mm_set1_ps(below);
-      for (int x = 0; x < CellTile::kDim; x += 4)
+      for (int x = 0; x < CellTile::kDim; x += 4)  // reads into the next row / the padding
         ins |= std::uint32_t(_mm_movemask_ps(_mm_cmplt_ps(_mm_loadu_ps(v + x), lim))) << x;
+      ins &= kRowBits;
 #else
       for (int x = 0; x < CellTile::kDim; ++x) ins |= std::uint32_t(v[x] < below) << x;
 #endif
@@ -84,8 +84,14 @@ struct ValidCells {
         valid_rows[cr] = v;
         mixed_rows[cr] = v & o & ~n;
         if (y >= 0 && z >= 0) mixed_cells += std::popcount((mixed_rows[cr] >> kH) & 0xffu);
-        for (int x = -1; x < kBrickDim; ++x) flags[index(x, y, z)] = std::uint8_t((v >> (x + kH)) & 1u);
       }
+  }
+  // Cell (x, y, z) with all 8 corners active, for any cell in [-1, 9)^3.
+  bool cell_valid(int x, int y, int z) const {
+    const int r = row(y, z);
+    constexpr int D = CellTile::kDim;
+    const std::uint32_t a = active_rows[r] & active_rows[r + 1] & active_rows[r + D] & active_rows[r + D + 1];
+    return ((a >> (x + kH)) & 3u) == 3u;
   }
   std::uint32_t mixed_row(int y, int z) const { return mixed_rows[(y + 1) + kN * (z + 1)]; }
   // Grid edges from (x, y, z), x in [-1, 9), along axis a whose both ends are active and lie on
@@ -165,8 +171,8 @@ struct SlotBits {
 };
 
 // Central-difference gradients of a tile at the corners of the cells [lo, 8)^3 that cross iso
-// (voxel rows holding such corners only), in value units per voxel, computed row by row
-// (vectorised) once per brick. Entries of other voxels are stale.
+// (voxel rows holding such corners only; lo >= 0, the tile starts at -1), in value units per
+// voxel, computed row by row (vectorised) once per brick. Entries of other voxels are stale.
 struct GradientTile {
   std::vector<float> g[3] = {std::vector<float>(CellTile::kSize), std::vector<float>(CellTile::kSize),
                              std::vector<float>(CellTile::kSize)};
@@ -175,20 +181,21 @@ struct GradientTile {
     std::array<std::uint16_t, kRows> need{};  // bit y + 1 of need[z + 1]
     for (int z = lo; z < kBrickDim; ++z)
       for (int y = lo; y < kBrickDim; ++y)
-        if (valid.mixed_row(y, z) & ValidCells::x_bits(lo, kBrickDim) << 1) {
+        if (valid.mixed_row(y, z) & ValidCells::x_bits(lo, kBrickDim) << (ValidCells::kH - 1)) {
           const std::uint16_t two = std::uint16_t(3u << (y + 1));
           need[std::size_t(z + 1)] |= two;
           need[std::size_t(z + 2)] |= two;
         }
     const float* __restrict v = t.values.data();
+    const int n = kBrickDim + 1 - lo;
     for (int z = lo; z <= kBrickDim; ++z)
       for (std::uint32_t ys = need[std::size_t(z + 1)]; ys != 0; ys &= ys - 1) {
         const int y = std::countr_zero(ys) - 1;
-        const int p = CellTile::index(-1, y, z);
+        const int p = CellTile::index(lo, y, z);
         for (int a = 0; a < 3; ++a) {
           const int st = kTileStride[a];
           float* __restrict out = g[a].data() + p;
-          for (int x = 0; x < kBrickDim + 2; ++x) out[x] = 0.5f * (v[p + x + st] - v[p + x - st]);
+          for (int x = 0; x < n; ++x) out[x] = 0.5f * (v[p + x + st] - v[p + x - st]);
         }
       }
   }
@@ -279,7 +286,7 @@ void for_brick_batches(std::uint32_t bricks, const ProgressHook& progress, std::
 
 // Vertex keys of the per-brick outputs: the owning brick as its slot in the emitting brick's
 // 3x3x3 neighbourhood (CellTile::neighbor_slot, 5 bits) and the vertex slot in that brick.
-inline constexpr int kKeySlotBits = 12;
+inline constexpr int kKeySlotBits = 13;
 using VertexKey = std::uint32_t;
 inline VertexKey vertex_key(int neighbor_slot, int slot) {
   return VertexKey(neighbor_slot) << kKeySlotBits | VertexKey(slot);
@@ -297,6 +304,14 @@ struct MergeOffsets {
   std::vector<std::uint64_t> triangle;  // first triangle of each brick (bricks + 1 entries)
 };
 
+// Quads (4 VertexKeys, outward order) of an Out that has them; split into 2 triangles at merge
+// time, once every vertex position is known.
+template <typename Out>
+std::size_t quad_count(const Out& o) {
+  if constexpr (requires { o.quads; }) return o.quads.size();
+  else return 0;
+}
+
 template <typename Out>
 MergeOffsets merge_offsets(std::vector<Out>& outs, SurfaceResult& r, std::string_view who) {
   const std::size_t nb = outs.size();
@@ -307,29 +322,45 @@ MergeOffsets merge_offsets(std::vector<Out>& outs, SurfaceResult& r, std::string
     total += outs[b].vertices.size();
     if (total >= 0xffffffffull)
       throw Error(ErrorCode::LimitExceeded, std::string(who), "more than 2^32 - 1 vertices");
-    m.triangle[b + 1] = m.triangle[b] + outs[b].triangles.size();
+    m.triangle[b + 1] = m.triangle[b] + outs[b].triangles.size() + 2 * quad_count(outs[b]);
     outs[b].owned.finish();
     r.cells_with_surface += outs[b].cells;
   }
   m.vertex[nb] = std::uint32_t(total);
-  r.mesh.vertices.resize(total);
-  r.normals.resize(total);
+  r.mesh.vertices.reserve(total);
+  r.normals.reserve(total);
   r.mesh.triangles.resize(m.triangle[nb]);
   return m;
 }
 
+// Vertices and normals are appended in brick order (one pass over fresh memory, no zero fill
+// first), then the triangles are filled in parallel (quads are split along their Delaunay
+// diagonal, which needs the vertices of neighbouring bricks).
 template <typename Out, typename Remap>
 void copy_merged(const std::vector<Out>& outs, const MergeOffsets& m, Remap&& remap, SurfaceResult& r) {
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, outs.size(), 64),
-                    [&](const tbb::blocked_range<std::size_t>& rg) {
+  for (const Out& o : outs) {
+    r.mesh.vertices.insert(r.mesh.vertices.end(), o.vertices.begin(), o.vertices.end());
+    r.normals.insert(r.normals.end(), o.normals.begin(), o.normals.end());
+  }
+  const tbb::blocked_range<std::size_t> all(0, outs.size(), 64);
+  tbb::parallel_for(all, [&](const tbb::blocked_range<std::size_t>& rg) {
     for (std::size_t b = rg.begin(); b != rg.end(); ++b) {
       const Out& o = outs[b];
-      std::copy(o.vertices.begin(), o.vertices.end(), r.mesh.vertices.begin() + m.vertex[b]);
-      std::copy(o.normals.begin(), o.normals.end(), r.normals.begin() + m.vertex[b]);
-      for (std::size_t i = 0; i < o.triangles.size(); ++i) {
-        const auto& k = o.triangles[i];
-        auto global = [&](VertexKey key) { return remap(o.around[std::size_t(key_neighbor(key))], key_slot(key)); };
-        r.mesh.triangles[m.triangle[b] + i] = {global(k[0]), global(k[1]), global(k[2])};
+      auto global = [&](VertexKey key) { return remap(o.around[std::size_t(key_neighbor(key))], key_slot(key)); };
+      auto* dst = r.mesh.triangles.data() + m.triangle[b];
+      for (const auto& k : o.triangles) *dst++ = {global(k[0]), global(k[1]), global(k[2])};
+      if constexpr (requires { o.quads; }) {
+        for (const auto& k : o.quads) {
+          const std::uint32_t g[4] = {global(k[0]), global(k[1]), global(k[2]), global(k[3])};
+          const Vec3d p[4] = {r.mesh.vertices[g[0]], r.mesh.vertices[g[1]], r.mesh.vertices[g[2]], r.mesh.vertices[g[3]]};
+          if (split_02(p)) {
+            *dst++ = {g[0], g[1], g[2]};
+            *dst++ = {g[0], g[2], g[3]};
+          } else {
+            *dst++ = {g[1], g[2], g[3]};
+            *dst++ = {g[1], g[3], g[0]};
+          }
+        }
       }
     }
   });

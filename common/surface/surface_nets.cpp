@@ -5,6 +5,7 @@
 #include <bit>
 #include <chrono>
 #include <cmath>
+#include <optional>
 
 #include <tbb/enumerable_thread_specific.h>
 
@@ -19,14 +20,20 @@ using namespace surface_detail;
 
 namespace {
 
+// Vertex slots of a brick: 4 * local cell index + loop for the one vertex of a loop; split
+// loops (see the header) have one vertex per loop edge at kSplitSlot0 + 12 * cell + edge.
 constexpr int kLoopSlots = kBrickVoxels * 4;  // 2048
+constexpr int kSplitSlot0 = kLoopSlots;
 
 struct BrickOut {
-  std::vector<Vec3d> vertices;
+  std::vector<Vec3d> vertices;  // loop vertices in slot order, then split-loop vertices in slot order
   std::vector<Vec3f> normals;
   std::vector<std::array<VertexKey, 3>> triangles;
+  std::vector<std::array<VertexKey, 4>> quads;
   std::array<std::uint32_t, 27> around{};
   SlotBits<kLoopSlots> owned;
+  std::vector<std::uint16_t> split_slots;  // sorted, slot - kSplitSlot0
+  std::uint32_t loop_vertices = 0;
   std::uint64_t cells = 0;
 };
 
@@ -49,43 +56,109 @@ struct CellField {
       for (int c = 0; c < 4; ++c) q[j][c] = r[2 * j][c] + f.y * (r[2 * j + 1][c] - r[2 * j][c]);
     for (int c = 0; c < 4; ++c) out[c] = q[0][c] + f.z * (q[1][c] - q[0][c]);
   }
+  // Newton steps from c (cell-local) along the interpolated gradient onto the trilinear zero
+  // level, clamped to the cell. Stops after a step shorter than 1e-4 voxel: Newton converges
+  // quadratically here, so the next step would be far below float precision.
+  Vec3d project(Vec3d c, int iterations) const {
+    for (int it = 0; it < iterations; ++it) {
+      double f[4];
+      eval(c, f);
+      const double gg = f[1] * f[1] + f[2] * f[2] + f[3] * f[3];
+      if (!(gg > 1e-12)) break;
+      const double k = f[0] / gg;
+      c = {std::clamp(c.x - k * f[1], 0.0, 1.0), std::clamp(c.y - k * f[2], 0.0, 1.0),
+           std::clamp(c.z - k * f[3], 0.0, 1.0)};
+      if (f[0] * f[0] < 1e-8 * gg) break;  // step length |phi| / |grad| < 1e-4
+    }
+    return c;
+  }
+  Vec3f normal(const Vec3d& c) const {
+    double f[4];
+    eval(c, f);
+    return normalized_f({f[1], f[2], f[3]});
+  }
 };
 
-// Vertex of loop l of a cell in cell-local coordinates [0, 1]^3: the mean of its edge
-// crossings, then Newton steps along the interpolated gradient onto the trilinear zero level
-// (stopping once a step would move it by less than 1e-7 voxel).
-Vec3d loop_vertex(const EdgeCrossings& edges, const CellField& cf, int x, int y, int z,
-                  const cell::LoopSet& ls, int l, int iterations) {
+// Cell-local crossing point of cell edge e of the cell with tile index p0.
+inline Vec3d crossing(const EdgeCrossings& edges, int p0, int e) {
+  const int k = cell::edge_lower_corner(e), a = e >> 2;
+  const double s = edges.at(p0 + kCornerOffset[k], a);
+  return {a == 0 ? s : double(k & 1), a == 1 ? s : double((k >> 1) & 1), a == 2 ? s : double((k >> 2) & 1)};
+}
+
+inline Vec3d loop_centroid(const EdgeCrossings& edges, int p0, const cell::LoopSet& ls, int l) {
   Vec3d c{};
-  const int n = ls.length[l];
-  for (int i = 0; i < n; ++i) {
-    const int e = ls.edges[ls.begin[l] + i];
-    const int k = cell::edge_lower_corner(e);
-    c += edges.point(x + (k & 1), y + ((k >> 1) & 1), z + ((k >> 2) & 1), e >> 2);
+  for (int i = 0; i < ls.length[l]; ++i) c += crossing(edges, p0, ls.edges[ls.begin[l] + i]);
+  return c / double(ls.length[l]);
+}
+
+const cell::LoopSet& classify_cell(const CellTile& t, int x, int y, int z, double iso) {
+  double a[8];
+  const int p0 = CellTile::index(x, y, z);
+  for (int i = 0; i < 8; ++i) a[i] = double(t.values[p0 + kCornerOffset[i]]) - iso;
+  int m, d;
+  cell::classify(a, m, d);
+  return cell::loops_for(m, d);
+}
+
+// Loops of a cell read from the band itself, nullptr unless all 8 corners are active: for the
+// rare neighbour cell outside the tile (split test of a cell on the tile's low boundary).
+const cell::LoopSet* classify_from_band(const NarrowBand& band, const Coord& c, double iso) {
+  double a[8];
+  for (int i = 0; i < 8; ++i) {
+    const std::optional<float> v = band.value(c + Coord{i & 1, (i >> 1) & 1, (i >> 2) & 1});
+    if (!v) return nullptr;
+    a[i] = double(*v) - iso;
   }
-  c = c / double(n) - Vec3d{double(x), double(y), double(z)};
-  for (int it = 0; it < iterations; ++it) {
-    double f[4];
-    cf.eval(c, f);
-    const double gg = f[1] * f[1] + f[2] * f[2] + f[3] * f[3];
-    if (!(gg > 1e-12) || f[0] * f[0] < 1e-14 * gg) break;
-    const double k = f[0] / gg;
-    c = {std::clamp(c.x - k * f[1], 0.0, 1.0), std::clamp(c.y - k * f[2], 0.0, 1.0),
-         std::clamp(c.z - k * f[3], 0.0, 1.0)};
-  }
-  return c;
+  int m, d;
+  cell::classify(a, m, d);
+  return &cell::loops_for(m, d);
+}
+
+// Loops of the cell that must be split: the loop holds both segments of a face whose
+// neighbouring cell (valid) also has a loop holding both. One vertex per loop on each side
+// would join the two sheets crossing that face in one dual edge with 4 triangles.
+std::uint8_t split_loops(const NarrowBand& band, const Coord& base, const CellTile& t, const ValidCells& valid,
+                         int x, int y, int z, const cell::LoopSet& ls, double iso) {
+  std::uint8_t split = 0;
+  for (int l = 0; l < ls.loop_count; ++l)
+    for (std::uint32_t faces = ls.doubled_faces[l]; faces != 0; faces &= faces - 1) {
+      const int f = std::countr_zero(faces), a = f >> 1, step = (f & 1) ? 1 : -1;
+      int n[3] = {x, y, z};
+      n[a] += step;
+      const cell::LoopSet* other = nullptr;
+      if (n[a] >= -1) {
+        if (valid.cell_valid(n[0], n[1], n[2])) other = &classify_cell(t, n[0], n[1], n[2], iso);
+      } else {
+        other = classify_from_band(band, base + Coord{n[0], n[1], n[2]}, iso);
+      }
+      if (other == nullptr) continue;
+      bool doubled = false;
+      for (int k = 0; k < other->loop_count; ++k) doubled |= ((other->doubled_faces[k] >> (f ^ 1)) & 1) != 0;
+      if (doubled) {
+        split |= std::uint8_t(1u << l);
+        break;
+      }
+    }
+  return split;
 }
 
 constexpr int kCells = ValidCells::kN * ValidCells::kN * ValidCells::kN;
 
-// Per-thread scratch: the tile and the loops and vertices (cell-local) of the cells with min
-// corner in [-1, 8)^3 that cross iso.
+// Per-thread scratch: the tile, its edge crossings and gradients, and the loops and split
+// masks of the cells with min corner in [-1, 8)^3 that cross iso.
 struct Scratch {
   CellTile tile;
   EdgeCrossings edges;
   GradientTile grad;
   std::array<const cell::LoopSet*, kCells> loops{};
-  std::array<std::array<Vec3d, 4>, kCells> verts{};
+  std::array<std::uint8_t, kCells> split{};
+  struct SplitVertex {
+    std::uint16_t slot;
+    Vec3d position;
+    Vec3f normal;
+  };
+  std::vector<SplitVertex> split_vertices;
 };
 
 void process_brick(const NarrowBand& band, std::uint32_t b, double iso, int iterations,
@@ -100,39 +173,76 @@ void process_brick(const NarrowBand& band, std::uint32_t b, double iso, int iter
   valid.compute(t, iso);
   out.vertices.reserve(valid.mixed_cells + 8);
   out.normals.reserve(valid.mixed_cells + 8);
-  out.triangles.reserve(2 * valid.mixed_cells + 8);
-  s.edges.compute(t, valid, iso, -1);
-  s.grad.compute(t, valid, -1);
+  out.quads.reserve(valid.mixed_cells + 8);
+  s.edges.compute(t, valid, iso, 0);
+  s.grad.compute(t, valid, 0);
+  s.split_vertices.clear();
+  auto world = [&](int x, int y, int z, const Vec3d& local) {
+    return corner + (Vec3d{double(x), double(y), double(z)} + local) * h;
+  };
+  constexpr int kSelf = CellTile::neighbor_slot(0, 0, 0);
 
-  // Loops and vertices of every valid cell crossing iso; the owned ones (min corner in
-  // [0, 8)^3) are emitted in slot order with their normals.
+  // Loops of every valid cell crossing iso; vertices of the owned ones (min corner in
+  // [0, 8)^3), loop vertices in slot order.
+  bool any_split = false;
   for (int z = -1; z < kBrickDim; ++z)
     for (int y = -1; y < kBrickDim; ++y)
       for (std::uint32_t bits = valid.mixed_row(y, z) >> (ValidCells::kH - 1); bits != 0; bits &= bits - 1) {
         const int x = std::countr_zero(bits) - 1;
-        const int p0 = CellTile::index(x, y, z);
-        double a[8];
-        for (int i = 0; i < 8; ++i) a[i] = double(t.values[p0 + kCornerOffset[i]]) - iso;
-        int m, d;
-        cell::classify(a, m, d);
-        const cell::LoopSet& ls = cell::loops_for(m, d);
+        const cell::LoopSet& ls = classify_cell(t, x, y, z, iso);
         const int ci = ValidCells::index(x, y, z);
         s.loops[ci] = &ls;
-        if (ls.loop_count == 0) continue;
+        s.split[ci] = ls.doubled_face_loops ? split_loops(band, base, t, valid, x, y, z, ls, iso) : 0;
+        any_split |= s.split[ci] != 0;
+        if (ls.loop_count == 0 || x < 0 || y < 0 || z < 0) continue;
+        ++out.cells;
+        const int p0 = CellTile::index(x, y, z);
         const CellField cf(t, s.grad, p0, iso);
-        const bool owned = x >= 0 && y >= 0 && z >= 0;
-        out.cells += owned ? 1 : 0;
+        const int li = local_index(x, y, z);
         for (int l = 0; l < ls.loop_count; ++l) {
-          const Vec3d c = loop_vertex(s.edges, cf, x, y, z, ls, l, iterations);
-          s.verts[ci][l] = c;
-          if (!owned) continue;
-          double f[4];
-          cf.eval(c, f);
-          out.owned.set(4 * local_index(x, y, z) + l);
-          out.vertices.push_back(corner + (Vec3d{double(x), double(y), double(z)} + c) * h);
-          out.normals.push_back(normalized_f({f[1], f[2], f[3]}));
+          const Vec3d centre = loop_centroid(s.edges, p0, ls, l);
+          if (!((s.split[ci] >> l) & 1)) {
+            const Vec3d c = cf.project(centre, iterations);
+            out.owned.set(4 * li + l);
+            out.vertices.push_back(world(x, y, z, c));
+            out.normals.push_back(cf.normal(c));
+            continue;
+          }
+          // Split loop: one vertex per edge, between its crossing and the loop centre, and a
+          // cap polygon through them in loop order.
+          const int n = ls.length[l];
+          std::array<Vec3d, 12> pos;
+          std::array<VertexKey, 12> key;
+          for (int i = 0; i < n; ++i) {
+            const int e = ls.edges[ls.begin[l] + i];
+            const Vec3d c = cf.project((crossing(s.edges, p0, e) + centre) * 0.5, iterations);
+            const int slot = 12 * li + e;
+            s.split_vertices.push_back({std::uint16_t(slot), world(x, y, z, c), cf.normal(c)});
+            pos[std::size_t(i)] = c;
+            key[std::size_t(i)] = vertex_key(kSelf, kSplitSlot0 + slot);
+          }
+          const int f = best_fan_start(pos.data(), n);
+          for (int i = 1; i + 1 < n; ++i)
+            out.triangles.push_back({key[std::size_t(f)], key[std::size_t((f + i) % n)], key[std::size_t((f + i + 1) % n)]});
         }
       }
+  out.loop_vertices = std::uint32_t(out.vertices.size());
+  std::sort(s.split_vertices.begin(), s.split_vertices.end(),
+            [](const Scratch::SplitVertex& a, const Scratch::SplitVertex& b) { return a.slot < b.slot; });
+  for (const Scratch::SplitVertex& v : s.split_vertices) {
+    out.split_slots.push_back(v.slot);
+    out.vertices.push_back(v.position);
+    out.normals.push_back(v.normal);
+  }
+
+  // The vertex of cell (x, y, z) (in [-1, 8)^3, crossing iso) on its cell edge e.
+  auto vertex_on = [&](int x, int y, int z, int e) {
+    const int ci = ValidCells::index(x, y, z);
+    const int l = s.loops[ci]->loop_of_edge[e];
+    const int owner = CellTile::neighbor_slot(x < 0 ? -1 : 0, y < 0 ? -1 : 0, z < 0 ? -1 : 0);
+    const int li = local_index(x & 7, y & 7, z & 7);
+    return ((s.split[ci] >> l) & 1) ? vertex_key(owner, kSplitSlot0 + 12 * li + e) : vertex_key(owner, 4 * li + l);
+  };
 
   // Quads around owned crossing edges.
   for (int z = 0; z < kBrickDim; ++z)
@@ -142,43 +252,61 @@ void process_brick(const NarrowBand& band, std::uint32_t b, double iso, int iter
       for (std::uint32_t& c : cr) c = (c & ValidCells::x_bits(0, kBrickDim)) >> 1;  // owned edges, bit x
       for (std::uint32_t bits = cr[0] | cr[1] | cr[2]; bits != 0; bits &= bits - 1) {
         const int x = std::countr_zero(bits);
-        const int p = CellTile::index(x, y, z);
-        const bool p_in = double(t.values[p]) - iso < 0.0;
+        const bool p_in = double(t.values[std::size_t(CellTile::index(x, y, z))]) - iso < 0.0;
         for (int a = 0; a < 3; ++a) {
           if (!((cr[a] >> x) & 1u)) continue;
           const int bax = a == 0 ? 1 : 0, cax = a == 2 ? 1 : 2;
           static constexpr int kOrder[4][2] = {{0, 0}, {1, 0}, {1, 1}, {0, 1}};
           std::array<VertexKey, 4> key;
-          std::array<Vec3d, 4> pos;
           bool ok = true;
           for (int k = 0; k < 4 && ok; ++k) {
             int c[3] = {x, y, z};
             c[bax] -= kOrder[k][0];
             c[cax] -= kOrder[k][1];
-            if (!valid.at(c[0], c[1], c[2])) { ok = false; break; }
-            const int ci = ValidCells::index(c[0], c[1], c[2]);
-            const int e = 4 * a + kOrder[k][0] + 2 * kOrder[k][1];
-            const int l = s.loops[ci]->loop_of_edge[e];
-            pos[k] = Vec3d{double(c[0]), double(c[1]), double(c[2])} + s.verts[ci][l];
-            const int owner = CellTile::neighbor_slot(c[0] < 0 ? -1 : 0, c[1] < 0 ? -1 : 0, c[2] < 0 ? -1 : 0);
-            key[k] = vertex_key(owner, 4 * local_index(c[0] & 7, c[1] & 7, c[2] & 7) + l);
+            ok = valid.at(c[0], c[1], c[2]);
+            if (ok) key[std::size_t(k)] = vertex_on(c[0], c[1], c[2], 4 * a + kOrder[k][0] + 2 * kOrder[k][1]);
           }
           if (!ok) continue;
           // kOrder turns about +a for x and z and about -a for y; outside lies at +a when p is in.
-          if ((a == 1) == p_in) {
-            std::swap(key[1], key[3]);
-            std::swap(pos[1], pos[3]);
-          }
-          if (split_02(pos.data())) {
-            out.triangles.push_back({key[0], key[1], key[2]});
-            out.triangles.push_back({key[0], key[2], key[3]});
-          } else {
-            out.triangles.push_back({key[1], key[2], key[3]});
-            out.triangles.push_back({key[1], key[3], key[0]});
-          }
+          if ((a == 1) == p_in) std::swap(key[1], key[3]);
+          out.quads.push_back(key);
         }
       }
     }
+  if (!any_split) return;
+
+  // Seams where a split loop meets its neighbour across a face: each owned cell closes the
+  // gaps on its three lower faces. The segment ea -> eb (this cell's loop order) is traversed
+  // eb -> ea by the lower cell; the seam runs v(eb), v(ea) here, then v(ea), v(eb) there.
+  for (int z = 0; z < kBrickDim; ++z)
+    for (int y = 0; y < kBrickDim; ++y)
+      for (std::uint32_t bits = (valid.mixed_row(y, z) >> ValidCells::kH) & 0xffu; bits != 0; bits &= bits - 1) {
+        const int x = std::countr_zero(bits);
+        const int ci = ValidCells::index(x, y, z);
+        const cell::LoopSet& ls = *s.loops[ci];
+        for (int l = 0; l < ls.loop_count; ++l) {
+          const int n = ls.length[l];
+          for (int i = 0; i < n; ++i) {
+            const int ea = ls.edges[ls.begin[l] + i], eb = ls.edges[ls.begin[l] + (i + 1) % n];
+            const int f = cell::common_face(ea, eb);
+            if (f < 0 || (f & 1) != 0) continue;
+            const int a = f >> 1;
+            int c[3] = {x, y, z};
+            c[a] -= 1;
+            if (!valid.at(c[0], c[1], c[2])) continue;
+            const int cj = ValidCells::index(c[0], c[1], c[2]);
+            const int la = cell::edge_from_lower_neighbor(ea, a), lb = cell::edge_from_lower_neighbor(eb, a);
+            const bool here = (s.split[ci] >> l) & 1;
+            const bool there = (s.split[cj] >> s.loops[cj]->loop_of_edge[la]) & 1;
+            if (!here && !there) continue;
+            const VertexKey ha = vertex_on(x, y, z, ea), hb = vertex_on(x, y, z, eb);
+            const VertexKey ta = vertex_on(c[0], c[1], c[2], la), tb = vertex_on(c[0], c[1], c[2], lb);
+            if (here && there) out.quads.push_back({hb, ha, ta, tb});
+            else if (here) out.triangles.push_back({hb, ha, ta});
+            else out.triangles.push_back({ha, ta, tb});
+          }
+        }
+      }
 }
 
 }  // namespace
@@ -197,7 +325,14 @@ SurfaceResult surface_nets(const NarrowBand& band, const SurfaceNetsOptions& opt
   });
   SurfaceResult r;
   const MergeOffsets m = merge_offsets(outs, r, "surface_nets");
-  auto remap = [&](std::uint32_t owner, int slot) { return m.vertex[owner] + outs[owner].owned.rank(slot); };
+  auto remap = [&](std::uint32_t owner, int slot) {
+    const BrickOut& o = outs[owner];
+    if (slot < kSplitSlot0) return m.vertex[owner] + o.owned.rank(slot);
+    const auto it = std::lower_bound(o.split_slots.begin(), o.split_slots.end(), std::uint16_t(slot - kSplitSlot0));
+    if (it == o.split_slots.end() || *it != std::uint16_t(slot - kSplitSlot0))
+      throw Error(ErrorCode::Corrupt, "surface_nets", "internal: a split-loop vertex is missing");
+    return m.vertex[owner] + o.loop_vertices + std::uint32_t(it - o.split_slots.begin());
+  };
   copy_merged(outs, m, remap, r);
   r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return r;
