@@ -11,18 +11,6 @@ namespace levelset {
 
 namespace {
 
-// Neighbour brick at offset d in {-1,0,1}^3 through face links; hash only when the face
-// path is broken but a diagonal brick may still exist.
-std::uint32_t neighbor_at(const NarrowBand& band, std::uint32_t b, const Coord& d) {
-  std::uint32_t cur = b;
-  for (int a = 0; a < 3 && cur != kNoBrick; ++a) {
-    if (d[a] != 0) cur = band.neighbor(cur, Face(2 * a + (d[a] > 0 ? 1 : 0)));
-  }
-  const int axes = (d.x != 0) + (d.y != 0) + (d.z != 0);
-  if (cur == kNoBrick && axes > 1) cur = band.find_brick(band.bricks()[b].coord + d);
-  return cur;
-}
-
 // kActiveBefore[m], nibble x: the number of set bits of the byte m below bit x.
 constexpr std::array<std::uint32_t, 256> make_active_before() {
   std::array<std::uint32_t, 256> t{};
@@ -39,6 +27,33 @@ constexpr std::array<std::uint32_t, 256> make_active_before() {
 constexpr std::array<std::uint32_t, 256> kActiveBefore = make_active_before();
 
 }  // namespace
+
+Neighborhood brick_neighborhood(const NarrowBand& band, std::uint32_t brick) {
+  Neighborhood n;
+  n.fill(kNoBrick);
+  n[Neighborhood::slot(0, 0, 0)] = brick;
+  // Faces, then edges, then corners: each one face link from a resolved brick one step nearer;
+  // a hash lookup only when every such path is unallocated (the brick may still exist).
+  for (int axes = 1; axes <= 3; ++axes)
+    for (int k = 0; k < 27; ++k) {
+      const Coord d = Neighborhood::offset(k);
+      if ((d.x != 0) + (d.y != 0) + (d.z != 0) != axes) continue;
+      std::uint32_t found = kNoBrick;
+      bool path = false;
+      for (int a = 0; a < 3 && found == kNoBrick; ++a) {
+        if (d[a] == 0) continue;
+        Coord nearer = d;
+        nearer[a] = 0;
+        const std::uint32_t from = n[std::size_t(Neighborhood::slot(nearer.x, nearer.y, nearer.z))];
+        if (from == kNoBrick) continue;
+        path = true;
+        found = band.neighbor(from, Face(2 * a + (d[a] > 0 ? 1 : 0)));
+      }
+      if (!path) found = band.find_brick(band.bricks()[brick].coord + d);
+      n[std::size_t(k)] = found;
+    }
+  return n;
+}
 
 void decode_brick(const NarrowBand& band, std::uint32_t brick, std::span<float, kBrickVoxels> out) {
   const Brick& br = band.bricks()[brick];
@@ -65,6 +80,12 @@ void gather_tile(const NarrowBand& band, std::uint32_t brick, int halo, std::spa
 
 void gather_box(const NarrowBand& band, std::uint32_t brick, int lo, int hi, std::span<float> out,
                 std::span<std::uint32_t> active_rows) {
+  gather_box(band, brick_neighborhood(band, brick), lo, hi, out, active_rows);
+}
+
+void gather_box(const NarrowBand& band, const Neighborhood& around, int lo, int hi, std::span<float> out,
+                std::span<std::uint32_t> active_rows) {
+  const std::uint32_t brick = around[std::size_t(Neighborhood::slot(0, 0, 0))];
   if (lo < -kBrickDim || lo > 0 || hi < kBrickDim || hi > 2 * kBrickDim)
     throw Error(ErrorCode::InvalidArgument, "gather_box", "need -8 <= lo <= 0 and 8 <= hi <= 16");
   const std::size_t dim = std::size_t(hi - lo);
@@ -95,12 +116,17 @@ void gather_box(const NarrowBand& band, std::uint32_t brick, int lo, int hi, std
           empty |= nlo[a] >= nhi[a];
         }
         if (empty) continue;
-        const std::uint32_t nb = (dx | dy | dz) == 0 ? brick : neighbor_at(band, brick, d);
+        const std::uint32_t nb = around[std::size_t(Neighborhood::slot(dx, dy, dz))];
         const int width = nhi[0] - nlo[0];
         if (nb == kNoBrick) {
-          // Unallocated: one sign for the whole brick (band invariant).
-          const Coord probe = brick_origin(self + d) + Coord{nlo[0], nlo[1], nlo[2]};
-          const float v = band.is_inside_unallocated(probe) ? -bg : bg;
+          // Unallocated: one sign for the whole brick (band invariant), by the band's x-row
+          // rule; when the next brick along +x is a neighbour here, that rule reads its first
+          // column, without the search.
+          const std::uint32_t next = dx < 1 ? around[std::size_t(Neighborhood::slot(dx + 1, dy, dz))] : kNoBrick;
+          const bool inside = next != kNoBrick
+                                  ? band.voxel_inside(next, local_index(0, nlo[1], nlo[2]))
+                                  : band.is_inside_unallocated(brick_origin(self + d) + Coord{nlo[0], nlo[1], nlo[2]});
+          const float v = inside ? -bg : bg;
           for (int z = nlo[2]; z < nhi[2]; ++z)
             for (int y = nlo[1]; y < nhi[1]; ++y)
               std::fill_n(&out[index(nlo[0] + dx * kBrickDim, y + dy * kBrickDim, z + dz * kBrickDim)], width, v);

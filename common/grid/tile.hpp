@@ -10,6 +10,7 @@
 // Threading: reads only; one tile buffer per thread.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <span>
 #include <vector>
@@ -35,11 +36,22 @@ void gather_tile(const NarrowBand& band, std::uint32_t brick, int halo, std::spa
 void gather_tile(const NarrowBand& band, std::uint32_t brick, int halo, std::span<float> out,
                  std::span<std::uint32_t> active_rows);
 
+// A brick and its 26 neighbours (kNoBrick where unallocated), slot(dx, dy, dz) for offsets in
+// {-1, 0, 1}^3. Face links, a hash lookup only for a brick no face path reaches.
+struct Neighborhood : std::array<std::uint32_t, 27> {
+  static constexpr int slot(int dx, int dy, int dz) { return (dx + 1) + 3 * (dy + 1) + 9 * (dz + 1); }
+  static constexpr Coord offset(int k) { return {k % 3 - 1, (k / 3) % 3 - 1, k / 9 - 1}; }
+};
+Neighborhood brick_neighborhood(const NarrowBand& band, std::uint32_t brick);
+
 // The general form: the box [lo, hi)^3 of brick-local voxel coordinates (-8 <= lo <= 0,
 // 8 <= hi <= 16; dim = hi - lo), index (x-lo) + dim*((y-lo) + dim*(z-lo)); active_rows may be
 // empty, else it has dim^2 entries (bit x-lo of entry (y-lo) + dim*(z-lo)).
 // gather_tile(halo) is gather_box(-halo, 8 + halo).
 void gather_box(const NarrowBand& band, std::uint32_t brick, int lo, int hi, std::span<float> out,
+                std::span<std::uint32_t> active_rows);
+// With the neighbourhood already resolved (around[slot(0, 0, 0)] is the brick).
+void gather_box(const NarrowBand& band, const Neighborhood& around, int lo, int hi, std::span<float> out,
                 std::span<std::uint32_t> active_rows);
 
 // Dense 512 values of one brick (halo 0) into out[local_index].

@@ -5,7 +5,7 @@
 // Inputs: a band and a brick index. Output: dense 11^3 values (grid/tile.hpp gather_box layout,
 // +-background outside the band; 4 floats of padding at the end for vector loads), active row
 // bitmasks (bit x + kHalo of row (y, z) where the band stores voxel (x, y, z)), and the indices
-// of the brick and its 26 neighbours (around[neighbor_slot(d)] for d in {-1,0,1}^3; kNoBrick
+// of the brick and its 26 neighbours (around[Neighborhood::slot(d)] for d in {-1,0,1}^3; kNoBrick
 // where unallocated). Cost: O(11^3) plus up to 26 neighbour resolutions (face links, a hash
 // lookup only for a diagonal brick whose face path is unallocated). Threading: one tile per
 // thread; the band is read only.
@@ -30,8 +30,7 @@ struct CellTile {
   std::vector<float> values = std::vector<float>(kSize + kPadding);
   static constexpr int row(int y, int z) { return (y + kHalo) + kDim * (z + kHalo); }
   std::array<std::uint32_t, kDim * kDim> active_rows{};
-  static constexpr int neighbor_slot(int dx, int dy, int dz) { return (dx + 1) + 3 * (dy + 1) + 9 * (dz + 1); }
-  std::array<std::uint32_t, 27> around{};
+  Neighborhood around{};
 };
 
 void gather_cell_tile(const NarrowBand& band, std::uint32_t brick, CellTile& tile);

@@ -26,7 +26,7 @@ struct BrickOut {
   std::vector<Vec3d> vertices;   // owned edge vertices in slot order, then centroids
   std::vector<Vec3f> normals;
   std::vector<std::array<VertexKey, 3>> triangles;
-  std::array<std::uint32_t, 27> around{};
+  Neighborhood around{};
   SlotBits<kEdgeSlots> owned;
   std::uint32_t edge_vertices = 0;
   std::uint64_t cells = 0;
@@ -95,7 +95,7 @@ void process_brick(const NarrowBand& band, std::uint32_t b, double iso, Scratch&
             const int e = edges[i];
             const int c = cell::edge_lower_corner(e);
             const int ex = x + (c & 1), ey = y + ((c >> 1) & 1), ez = z + ((c >> 2) & 1);
-            key[i] = vertex_key(CellTile::neighbor_slot(ex >> 3, ey >> 3, ez >> 3),
+            key[i] = vertex_key(Neighborhood::slot(ex >> 3, ey >> 3, ez >> 3),
                                 3 * local_index(ex & 7, ey & 7, ez & 7) + (e >> 2));
           }
           if (n == 3) {
@@ -111,7 +111,7 @@ void process_brick(const NarrowBand& band, std::uint32_t b, double iso, Scratch&
             Vec3d c{};
             for (int i = 0; i < n; ++i) c += pos[i];
             c = c / double(n);
-            const VertexKey ck = vertex_key(CellTile::neighbor_slot(0, 0, 0), kEdgeSlots + int(out.extra));
+            const VertexKey ck = vertex_key(Neighborhood::slot(0, 0, 0), kEdgeSlots + int(out.extra));
             out.vertices.push_back(corner + c * h);
             out.normals.push_back(normalized_f(gradient_at(t, c, x, y, z)));
             ++out.extra;

@@ -22,6 +22,7 @@
 #include <tbb/parallel_for.h>
 
 #include "core/error.hpp"
+#include "core/huge_pages.hpp"
 #include "core/progress.hpp"
 #include "core/vec3.hpp"
 #include "grid/narrow_band.hpp"
@@ -285,7 +286,7 @@ void for_brick_batches(std::uint32_t bricks, const ProgressHook& progress, std::
                        const std::function<void(std::uint32_t)>& f);
 
 // Vertex keys of the per-brick outputs: the owning brick as its slot in the emitting brick's
-// 3x3x3 neighbourhood (CellTile::neighbor_slot, 5 bits) and the vertex slot in that brick.
+// 3x3x3 neighbourhood (Neighborhood::slot, 5 bits) and the vertex slot in that brick.
 inline constexpr int kKeySlotBits = 13;
 using VertexKey = std::uint32_t;
 inline VertexKey vertex_key(int neighbor_slot, int slot) {
@@ -327,22 +328,23 @@ MergeOffsets merge_offsets(std::vector<Out>& outs, SurfaceResult& r, std::string
     r.cells_with_surface += outs[b].cells;
   }
   m.vertex[nb] = std::uint32_t(total);
-  r.mesh.vertices.reserve(total);
-  r.normals.reserve(total);
-  r.mesh.triangles.resize(m.triangle[nb]);
+  resize_with_huge_pages(r.mesh.vertices, total);
+  resize_with_huge_pages(r.normals, total);
+  resize_with_huge_pages(r.mesh.triangles, m.triangle[nb]);
   return m;
 }
 
-// Vertices and normals are appended in brick order (one pass over fresh memory, no zero fill
-// first), then the triangles are filled in parallel (quads are split along their Delaunay
-// diagonal, which needs the vertices of neighbouring bricks).
+// Two parallel passes over the bricks: vertices and normals, then triangles (quads are split
+// along their Delaunay diagonal, which needs the vertices of neighbouring bricks).
 template <typename Out, typename Remap>
 void copy_merged(const std::vector<Out>& outs, const MergeOffsets& m, Remap&& remap, SurfaceResult& r) {
-  for (const Out& o : outs) {
-    r.mesh.vertices.insert(r.mesh.vertices.end(), o.vertices.begin(), o.vertices.end());
-    r.normals.insert(r.normals.end(), o.normals.begin(), o.normals.end());
-  }
   const tbb::blocked_range<std::size_t> all(0, outs.size(), 64);
+  tbb::parallel_for(all, [&](const tbb::blocked_range<std::size_t>& rg) {
+    for (std::size_t b = rg.begin(); b != rg.end(); ++b) {
+      std::copy(outs[b].vertices.begin(), outs[b].vertices.end(), r.mesh.vertices.begin() + m.vertex[b]);
+      std::copy(outs[b].normals.begin(), outs[b].normals.end(), r.normals.begin() + m.vertex[b]);
+    }
+  });
   tbb::parallel_for(all, [&](const tbb::blocked_range<std::size_t>& rg) {
     for (std::size_t b = rg.begin(); b != rg.end(); ++b) {
       const Out& o = outs[b];

@@ -30,7 +30,7 @@ struct BrickOut {
   std::vector<Vec3f> normals;
   std::vector<std::array<VertexKey, 3>> triangles;
   std::vector<std::array<VertexKey, 4>> quads;
-  std::array<std::uint32_t, 27> around{};
+  Neighborhood around{};
   SlotBits<kLoopSlots> owned;
   std::vector<std::uint16_t> split_slots;  // sorted, slot - kSplitSlot0
   std::uint32_t loop_vertices = 0;
@@ -38,44 +38,47 @@ struct BrickOut {
 };
 
 // One cell's corner values (minus iso) and corner central differences as 4 channels
-// (phi, gx, gy, gz), trilinearly interpolated at a local point f in [0, 1]^3.
+// (phi, gx, gy, gz), trilinearly interpolated at a local point f in [0, 1]^3. Single
+// precision: one 4-lane vector per corner, and vertex positions need ~1e-6 voxel at most.
 struct CellField {
-  double v[8][4];
+  alignas(16) float v[8][4];
   CellField(const CellTile& t, const GradientTile& gt, int p0, double iso) {
     for (int i = 0; i < 8; ++i) {
       const std::size_t p = std::size_t(p0 + kCornerOffset[i]);
-      v[i][0] = double(t.values[p]) - iso;
-      for (int a = 0; a < 3; ++a) v[i][a + 1] = double(gt.g[a][p]);
+      v[i][0] = float(double(t.values[p]) - iso);
+      for (int a = 0; a < 3; ++a) v[i][a + 1] = gt.g[a][p];
     }
   }
-  void eval(const Vec3d& f, double out[4]) const {
-    double r[4][4], q[2][4];
+  void eval(float fx, float fy, float fz, float out[4]) const {
+    float r[4][4], q[2][4];
     for (int k = 0; k < 4; ++k)
-      for (int c = 0; c < 4; ++c) r[k][c] = v[2 * k][c] + f.x * (v[2 * k + 1][c] - v[2 * k][c]);
+      for (int c = 0; c < 4; ++c) r[k][c] = v[2 * k][c] + fx * (v[2 * k + 1][c] - v[2 * k][c]);
     for (int j = 0; j < 2; ++j)
-      for (int c = 0; c < 4; ++c) q[j][c] = r[2 * j][c] + f.y * (r[2 * j + 1][c] - r[2 * j][c]);
-    for (int c = 0; c < 4; ++c) out[c] = q[0][c] + f.z * (q[1][c] - q[0][c]);
+      for (int c = 0; c < 4; ++c) q[j][c] = r[2 * j][c] + fy * (r[2 * j + 1][c] - r[2 * j][c]);
+    for (int c = 0; c < 4; ++c) out[c] = q[0][c] + fz * (q[1][c] - q[0][c]);
   }
   // Newton steps from c (cell-local) along the interpolated gradient onto the trilinear zero
   // level, clamped to the cell. Stops after a step shorter than 1e-4 voxel: Newton converges
-  // quadratically here, so the next step would be far below float precision.
-  Vec3d project(Vec3d c, int iterations) const {
+  // quadratically here, so the next step would be below float precision.
+  Vec3d project(const Vec3d& start, int iterations) const {
+    float x = float(start.x), y = float(start.y), z = float(start.z);
     for (int it = 0; it < iterations; ++it) {
-      double f[4];
-      eval(c, f);
-      const double gg = f[1] * f[1] + f[2] * f[2] + f[3] * f[3];
-      if (!(gg > 1e-12)) break;
-      const double k = f[0] / gg;
-      c = {std::clamp(c.x - k * f[1], 0.0, 1.0), std::clamp(c.y - k * f[2], 0.0, 1.0),
-           std::clamp(c.z - k * f[3], 0.0, 1.0)};
-      if (f[0] * f[0] < 1e-8 * gg) break;  // step length |phi| / |grad| < 1e-4
+      float f[4];
+      eval(x, y, z, f);
+      const float gg = f[1] * f[1] + f[2] * f[2] + f[3] * f[3];
+      if (!(gg > 1e-12f)) break;
+      const float k = f[0] / gg;
+      x = std::clamp(x - k * f[1], 0.0f, 1.0f);
+      y = std::clamp(y - k * f[2], 0.0f, 1.0f);
+      z = std::clamp(z - k * f[3], 0.0f, 1.0f);
+      if (f[0] * f[0] < 1e-8f * gg) break;  // step length |phi| / |grad| < 1e-4
     }
-    return c;
+    return {double(x), double(y), double(z)};
   }
   Vec3f normal(const Vec3d& c) const {
-    double f[4];
-    eval(c, f);
-    return normalized_f({f[1], f[2], f[3]});
+    float f[4];
+    eval(float(c.x), float(c.y), float(c.z), f);
+    return normalized_f({double(f[1]), double(f[2]), double(f[3])});
   }
 };
 
@@ -180,7 +183,7 @@ void process_brick(const NarrowBand& band, std::uint32_t b, double iso, int iter
   auto world = [&](int x, int y, int z, const Vec3d& local) {
     return corner + (Vec3d{double(x), double(y), double(z)} + local) * h;
   };
-  constexpr int kSelf = CellTile::neighbor_slot(0, 0, 0);
+  constexpr int kSelf = Neighborhood::slot(0, 0, 0);
 
   // Loops of every valid cell crossing iso; vertices of the owned ones (min corner in
   // [0, 8)^3), loop vertices in slot order.
@@ -239,7 +242,7 @@ void process_brick(const NarrowBand& band, std::uint32_t b, double iso, int iter
   auto vertex_on = [&](int x, int y, int z, int e) {
     const int ci = ValidCells::index(x, y, z);
     const int l = s.loops[ci]->loop_of_edge[e];
-    const int owner = CellTile::neighbor_slot(x < 0 ? -1 : 0, y < 0 ? -1 : 0, z < 0 ? -1 : 0);
+    const int owner = Neighborhood::slot(x < 0 ? -1 : 0, y < 0 ? -1 : 0, z < 0 ? -1 : 0);
     const int li = local_index(x & 7, y & 7, z & 7);
     return ((s.split[ci] >> l) & 1) ? vertex_key(owner, kSplitSlot0 + 12 * li + e) : vertex_key(owner, 4 * li + l);
   };
