@@ -34,7 +34,7 @@ inline void advise_huge_pages(const void* data, std::size_t bytes) {
 template <typename T>
 void resize_with_huge_pages(std::vector<T>& v, std::size_t n) {
   v.reserve(n);
-  if (n * sizeof(T) >= (std::size_t{4} << 21)) advise_huge_pages(v.data(), n * sizeof(T));
+  if (n * sizeof(T) >= (std::size_t{2} << 21)) advise_huge_pages(v.data(), n * sizeof(T));
   v.resize(n);
 }
 

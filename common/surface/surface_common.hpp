@@ -171,37 +171,6 @@ struct SlotBits {
   }
 };
 
-// Central-difference gradients of a tile at the corners of the cells [lo, 8)^3 that cross iso
-// (voxel rows holding such corners only; lo >= 0, the tile starts at -1), in value units per
-// voxel, computed row by row (vectorised) once per brick. Entries of other voxels are stale.
-struct GradientTile {
-  std::vector<float> g[3] = {std::vector<float>(CellTile::kSize), std::vector<float>(CellTile::kSize),
-                             std::vector<float>(CellTile::kSize)};
-  void compute(const CellTile& t, const ValidCells& valid, int lo) {
-    constexpr int kRows = kBrickDim + 2;  // voxel rows y, z in [-1, 9)
-    std::array<std::uint16_t, kRows> need{};  // bit y + 1 of need[z + 1]
-    for (int z = lo; z < kBrickDim; ++z)
-      for (int y = lo; y < kBrickDim; ++y)
-        if (valid.mixed_row(y, z) & ValidCells::x_bits(lo, kBrickDim) << (ValidCells::kH - 1)) {
-          const std::uint16_t two = std::uint16_t(3u << (y + 1));
-          need[std::size_t(z + 1)] |= two;
-          need[std::size_t(z + 2)] |= two;
-        }
-    const float* __restrict v = t.values.data();
-    const int n = kBrickDim + 1 - lo;
-    for (int z = lo; z <= kBrickDim; ++z)
-      for (std::uint32_t ys = need[std::size_t(z + 1)]; ys != 0; ys &= ys - 1) {
-        const int y = std::countr_zero(ys) - 1;
-        const int p = CellTile::index(lo, y, z);
-        for (int a = 0; a < 3; ++a) {
-          const int st = kTileStride[a];
-          float* __restrict out = g[a].data() + p;
-          for (int x = 0; x < n; ++x) out[x] = 0.5f * (v[p + x + st] - v[p + x - st]);
-        }
-      }
-  }
-};
-
 inline Vec3f normalized_f(const Vec3d& g) {
   const double l = length(g);
   if (!(l > 0.0)) return {0.0f, 0.0f, 0.0f};

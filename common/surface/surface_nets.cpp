@@ -37,16 +37,44 @@ struct BrickOut {
   std::uint64_t cells = 0;
 };
 
-// One cell's corner values (minus iso) and corner central differences as 4 channels
-// (phi, gx, gy, gz), trilinearly interpolated at a local point f in [0, 1]^3. Single
-// precision: one 4-lane vector per corner, and vertex positions need ~1e-6 voxel at most.
+// The field at the corners of the owned cells that cross iso (voxel rows holding such corners
+// only; other entries are stale): per voxel (phi - iso, central differences along x, y, z) in
+// value units (per voxel), computed once per brick, row by row.
+struct FieldTile {
+  std::vector<std::array<float, 4>> f = std::vector<std::array<float, 4>>(CellTile::kSize);
+  void compute(const CellTile& t, const ValidCells& valid, double iso) {
+    constexpr int kRows = kBrickDim + 1;  // voxel rows y, z in [0, 9)
+    std::array<std::uint16_t, kRows> need{};  // bit y of need[z]
+    for (int z = 0; z < kBrickDim; ++z)
+      for (int y = 0; y < kBrickDim; ++y)
+        if ((valid.mixed_row(y, z) >> ValidCells::kH) & 0xffu) {
+          const std::uint16_t two = std::uint16_t(3u << y);
+          need[std::size_t(z)] |= two;
+          need[std::size_t(z + 1)] |= two;
+        }
+    const float* v = t.values.data();
+    for (int z = 0; z <= kBrickDim; ++z)
+      for (std::uint32_t ys = need[std::size_t(z)]; ys != 0; ys &= ys - 1) {
+        const int p = CellTile::index(0, std::countr_zero(ys), z);
+        for (int x = 0; x <= kBrickDim; ++x) {
+          const float* c = v + p + x;
+          f[std::size_t(p + x)] = {float(double(*c) - iso), 0.5f * (c[kTileStride[0]] - c[-kTileStride[0]]),
+                                   0.5f * (c[kTileStride[1]] - c[-kTileStride[1]]),
+                                   0.5f * (c[kTileStride[2]] - c[-kTileStride[2]])};
+        }
+      }
+  }
+};
+
+// One cell's field channels (phi - iso, gx, gy, gz) at its 8 corners, trilinearly
+// interpolated at a local point f in [0, 1]^3. Single precision: one 4-lane vector per corner,
+// and vertex positions need ~1e-6 voxel at most.
 struct CellField {
   alignas(16) float v[8][4];
-  CellField(const CellTile& t, const GradientTile& gt, int p0, double iso) {
+  CellField(const FieldTile& ft, int p0) {
     for (int i = 0; i < 8; ++i) {
-      const std::size_t p = std::size_t(p0 + kCornerOffset[i]);
-      v[i][0] = float(double(t.values[p]) - iso);
-      for (int a = 0; a < 3; ++a) v[i][a + 1] = gt.g[a][p];
+      const std::array<float, 4>& c = ft.f[std::size_t(p0 + kCornerOffset[i])];
+      for (int k = 0; k < 4; ++k) v[i][k] = c[std::size_t(k)];
     }
   }
   void eval(float fx, float fy, float fz, float out[4]) const {
@@ -153,7 +181,7 @@ constexpr int kCells = ValidCells::kN * ValidCells::kN * ValidCells::kN;
 struct Scratch {
   CellTile tile;
   EdgeCrossings edges;
-  GradientTile grad;
+  FieldTile field;
   std::array<const cell::LoopSet*, kCells> loops{};
   std::array<std::uint8_t, kCells> split{};
   struct SplitVertex {
@@ -178,7 +206,7 @@ void process_brick(const NarrowBand& band, std::uint32_t b, double iso, int iter
   out.normals.reserve(valid.mixed_cells + 8);
   out.quads.reserve(valid.mixed_cells + 8);
   s.edges.compute(t, valid, iso, 0);
-  s.grad.compute(t, valid, 0);
+  s.field.compute(t, valid, iso);
   s.split_vertices.clear();
   auto world = [&](int x, int y, int z, const Vec3d& local) {
     return corner + (Vec3d{double(x), double(y), double(z)} + local) * h;
@@ -200,7 +228,7 @@ void process_brick(const NarrowBand& band, std::uint32_t b, double iso, int iter
         if (ls.loop_count == 0 || x < 0 || y < 0 || z < 0) continue;
         ++out.cells;
         const int p0 = CellTile::index(x, y, z);
-        const CellField cf(t, s.grad, p0, iso);
+        const CellField cf(s.field, p0);
         const int li = local_index(x, y, z);
         for (int l = 0; l < ls.loop_count; ++l) {
           const Vec3d centre = loop_centroid(s.edges, p0, ls, l);
