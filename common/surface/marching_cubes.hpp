@@ -11,11 +11,12 @@
 //   oriented with normals to the positive side. Each cell's contour is a set of closed loops
 //   (surface/cell_loops.hpp: face segments paired by the asymptotic decider, identical for the
 //   two cells sharing a face). A loop is fanned from the vertex that maximises the smallest
-//   angle; a loop holding both segments of an ambiguous face gets one extra vertex at its
+//   angle (a quad: its Delaunay diagonal); a loop holding both segments of an ambiguous face gets one extra vertex at its
 //   centroid instead (counted in extra_vertices), so that no diagonal is shared by two cells.
 //   The mesh is watertight, manifold and consistently oriented wherever the iso-surface lies
 //   inside the contoured cells.
-// Units: world (the band's frame). Cost: O(bricks * 12^3) plus O(output).
+// Units: world (the band's frame). Cost: O(bricks * 11^3) for the bricks whose cells can
+//   cross iso (others are skipped after one pass over the values) plus O(output).
 // Threading: TBB over bricks; per-brick buffers merged in brick order, so vertex and triangle
 //   arrays are identical for any thread count.
 // Errors: Error{InvalidArgument} when |iso| >= background() or iso is not finite;

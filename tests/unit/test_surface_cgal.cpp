@@ -29,6 +29,7 @@
 #include "io/mesh_reader.hpp"
 #include "shape_band.hpp"
 #include "surface/marching_cubes.hpp"
+#include "surface/surface_nets.hpp"
 #include "surface/mesh_measures.hpp"
 
 namespace levelset {
@@ -109,7 +110,7 @@ std::size_t stride_for(const TriangleMesh& from, const TriangleMesh& to) {
   return std::max<std::size_t>(1, std::size_t(std::ceil(double(from.vertices.size()) / samples)));
 }
 
-TEST(CgalSurfaces, ClosedManifoldInputsKeepTopologyAtR128) {
+TEST(CgalSurfaces, ClosedManifoldInputsKeepTopologyAtR128BothMethods) {
   const fs::path dir = cgal_meshes();
   if (!fs::is_directory(dir)) GTEST_SKIP() << "CGAL data meshes not installed: " << dir;
   std::vector<fs::path> files;
@@ -121,7 +122,7 @@ TEST(CgalSurfaces, ClosedManifoldInputsKeepTopologyAtR128) {
   struct Outcome {
     std::string name;
     enum { Unread, Open, Large, Tested } kind = Unread;
-    MeshMeasures in, out;
+    MeshMeasures in, out, nets;
     double seconds = 0;
     std::string error;
   };
@@ -137,7 +138,9 @@ TEST(CgalSurfaces, ClosedManifoldInputsKeepTopologyAtR128) {
       if (!closed_manifold(o.in)) { o.kind = Outcome::Open; return; }
       if (o.in.faces > kMaxTriangles) { o.kind = Outcome::Large; return; }
       o.kind = Outcome::Tested;
-      o.out = measure_mesh(extract(mesh).surface.mesh);
+      const Extracted e = extract(mesh);
+      o.out = measure_mesh(e.surface.mesh);
+      o.nets = measure_mesh(surface_nets(e.cpt.band).mesh);
     } catch (const std::exception& ex) {
       o.error = ex.what();
     }
@@ -154,6 +157,11 @@ TEST(CgalSurfaces, ClosedManifoldInputsKeepTopologyAtR128) {
     EXPECT_TRUE(o.error.empty()) << o.name << ": " << o.error;
     if (!o.error.empty()) continue;
     const bool ok = closed_manifold(o.out) && o.out.genus == o.in.genus;
+    // Surface nets contours the same cell loops: the same topology as marching cubes, always
+    // (also on the excluded meshes, where both differ from the input).
+    EXPECT_TRUE(closed_manifold(o.nets)) << o.name << " surface nets";
+    EXPECT_EQ(o.nets.euler_characteristic, o.out.euler_characteristic) << o.name << " surface nets";
+    EXPECT_EQ(o.nets.components, o.out.components) << o.name << " surface nets";
     std::ostringstream msg;
     msg << o.name << ": input genus " << o.in.genus << " components " << o.in.components << " faces "
         << o.in.faces << "; output genus " << o.out.genus << " components " << o.out.components
