@@ -10,6 +10,7 @@
 
 #include "commands/commands.hpp"
 #include "core/error.hpp"
+#include "evolve/speed.hpp"
 #include "geometry/analytic_shapes.hpp"
 
 namespace {
@@ -95,6 +96,37 @@ int main(int argc, char** argv) {
       ->check(CLI::IsMember({"mc", "nets"}));
   measure_cmd->add_flag("--json", measure.json, "Print JSON instead of text");
 
+  levelset::cli::EvolveArgs evolve;
+  CLI::App* evolve_cmd = app.add_subcommand("evolve", "Move the surface with a speed function (level set equation)");
+  evolve_cmd->add_option("input", evolve.input, "Input .lsg")->required();
+  evolve_cmd->add_option("-o,--output", evolve.output, "Output .lsg file")->required();
+  evolve_cmd->add_option("--speed", evolve.speed, "Built-in speed")
+      ->check(CLI::IsMember(levelset::evolve::builtin_speed_names()));
+  evolve_cmd->add_option("--c", evolve.c, "Speed constant (constant, one-minus-eps-kappa)");
+  evolve_cmd->add_option("--eps", evolve.eps, "Curvature weight (one-minus-eps-kappa)");
+  evolve_cmd->add_option("--velocity", evolve.velocity, "Constant advection velocity x,y,z (world units per time)")
+      ->delimiter(',')
+      ->expected(3);
+  auto* steps_opt = evolve_cmd->add_option("--steps", evolve.steps, "Number of time steps")->check(CLI::PositiveNumber);
+  auto* time_opt = evolve_cmd->add_option("--time", evolve.time, "Evolve until this time")->check(CLI::PositiveNumber);
+  steps_opt->excludes(time_opt);
+  evolve_cmd->add_option("--scheme", evolve.scheme, "Spatial scheme: godunov (first order), eno2, weno5")
+      ->check(CLI::IsMember({"godunov", "eno2", "weno5"}));
+  evolve_cmd->add_option("--hamiltonian", evolve.hamiltonian, "godunov, or llf (Local Lax-Friedrichs)")
+      ->check(CLI::IsMember({"godunov", "llf"}));
+  evolve_cmd->add_option("--rk", evolve.rk, "Time integration: 1 (forward Euler) or 3 (TVD-RK3)")
+      ->check(CLI::IsMember({1, 3}));
+  evolve_cmd->add_option("--cfl", evolve.cfl, "CFL number in (0, 1]")->check(CLI::Range(1e-6, 1.0));
+  evolve_cmd->add_option("--redistance-every", evolve.redistance_every, "Redistance every K steps (0: never)")
+      ->check(CLI::NonNegativeNumber);
+  evolve_cmd->add_option("--drift-tolerance", evolve.drift_tolerance,
+                         "Redistance when the mean ||grad u| - 1| near the surface exceeds this (0: off)")
+      ->check(CLI::NonNegativeNumber);
+  evolve_cmd->add_flag("--extension", evolve.extension, "Extension velocities (speed constant along normals)");
+  evolve_cmd->add_option("--report-every", evolve.report_every, "Print a progress line every N steps")
+      ->check(CLI::NonNegativeNumber);
+  add_common_options(evolve_cmd, threads, evolve.stats);
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -114,6 +146,17 @@ int main(int argc, char** argv) {
     if (*sample_cmd) return levelset::cli::run_sample(sample);
     if (*mesh_cmd) return levelset::cli::run_mesh(mesh);
     if (*measure_cmd) return levelset::cli::run_measure(measure);
+    if (*evolve_cmd) {
+      if (evolve.steps == 0 && evolve.time == 0.0) {
+        std::fprintf(stderr, "levelsetd: usage: evolve needs --steps N or --time T (see levelsetd evolve --help)\n");
+        return 2;
+      }
+      if (evolve.speed.empty() && evolve.velocity.empty()) {
+        std::fprintf(stderr, "levelsetd: usage: evolve needs --speed NAME or --velocity x,y,z (see levelsetd evolve --help)\n");
+        return 2;
+      }
+      return levelset::cli::run_evolve(evolve);
+    }
   } catch (const levelset::Error& e) {
     std::fprintf(stderr, "levelsetd: %s\n", e.what());
     return 1;

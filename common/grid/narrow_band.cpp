@@ -147,6 +147,13 @@ float NarrowBand::value_or_background(const Coord& c) const {
   return stored_inside(br, n) ? -background_ : background_;
 }
 
+void NarrowBand::swap_values(std::vector<float>& values) {
+  if (values.size() != values_.size())
+    throw Error(ErrorCode::InvalidArgument, "swap_values",
+                "expected " + std::to_string(values_.size()) + " values, got " + std::to_string(values.size()));
+  values_.swap(values);
+}
+
 bool NarrowBand::is_inside(const Coord& c) const {
   const std::uint32_t b = find_brick(brick_of(c));
   if (b == kNoBrick) return is_inside_unallocated(c);

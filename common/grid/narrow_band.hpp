@@ -157,6 +157,12 @@ class NarrowBand {
     });
   }
 
+  // Exchanges the active values with `values` (same size, band value order) in O(1): the
+  // topology and the stored signs of inactive voxels stay; active voxels take the signs of
+  // their new values, so callers keep the band invariant (no sign change at the band's
+  // edge). For time stepping. Error{InvalidArgument} when the sizes differ.
+  void swap_values(std::vector<float>& values);
+
   // Raw construction for BandBuilder and the file reader: records sorted by brick key
   // without duplicates, values packed record after record in active-mask order. Throws
   // Error{InvalidArgument} when the records break these rules.

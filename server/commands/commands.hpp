@@ -4,6 +4,7 @@
 #pragma once
 
 #include <string>
+#include <vector>
 
 #include "grid/narrow_band.hpp"
 #include "surface/surface_result.hpp"
@@ -72,5 +73,26 @@ int run_measure(const MeasureArgs& args);
 
 // The surface of a band by marching cubes ("mc") or surface nets ("nets").
 SurfaceResult extract_surface(const NarrowBand& band, const std::string& method, double iso);
+
+struct EvolveArgs {
+  std::string input;
+  std::string output;
+  std::string speed;               // a built-in speed name
+  double c = 1.0;                  // speed parameters (constant / one-minus-eps-kappa)
+  double eps = 0.1;
+  std::vector<double> velocity;    // x,y,z: constant advection velocity (world units per time)
+  int steps = 0;
+  double time = 0.0;
+  std::string scheme = "godunov";  // godunov | eno2 | weno5
+  std::string hamiltonian = "godunov";  // godunov | llf
+  int rk = 1;
+  double cfl = 0.5;
+  int redistance_every = 0;
+  double drift_tolerance = 0.0;
+  bool extension = false;
+  int report_every = 0;            // print a progress line every N steps (0: none)
+  std::string stats;
+};
+int run_evolve(const EvolveArgs& args);
 
 }  // namespace levelset::cli

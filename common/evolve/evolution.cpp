@@ -1,0 +1,533 @@
+#include "evolve/evolution.hpp"
+
+#include <algorithm>
+#include <array>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <span>
+#include <sstream>
+
+#include <tbb/blocked_range.h>
+#include <tbb/combinable.h>
+#include <tbb/enumerable_thread_specific.h>
+#include <tbb/parallel_for.h>
+
+#include "core/error.hpp"
+#include "distance/redistance.hpp"
+#include "evolve/band_tracking.hpp"
+#include "evolve/curvature.hpp"
+#include "grid/band_accessor.hpp"
+#include "grid/interpolate.hpp"
+#include "grid/tile.hpp"
+
+namespace levelset::evolve {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
+
+// Dense tile around one brick: the brick plus kStencilReach voxels on every side.
+constexpr int kLo = -kStencilReach, kHi = kBrickDim + kStencilReach, kDim = kHi - kLo;
+constexpr std::ptrdiff_t kStride[3] = {1, kDim, kDim * kDim};
+constexpr int tile_index(int x, int y, int z) { return (x - kLo) + kDim * ((y - kLo) + kDim * (z - kLo)); }
+constexpr double kSqrt3 = 1.7320508075688772;
+
+// Per-thread buffers for one brick (at most 512 active voxels).
+struct Scratch {
+  std::vector<float> tile = std::vector<float>(std::size_t(kDim) * kDim * kDim);
+  std::vector<std::uint32_t> rows = std::vector<std::uint32_t>(std::size_t(kDim) * kDim);
+  std::array<float, kBrickVoxels> d, x, y, z, nx, ny, nz, mean, gauss, k1, k2, grad, beta_a, beta_p;
+  std::array<std::array<OneSided, 3>, kBrickVoxels> os;
+  std::array<Vec3d, kBrickVoxels> vel;
+};
+
+bool active_at(const Scratch& s, int x, int y, int z) {
+  return (s.rows[std::size_t((y - kLo) + kDim * (z - kLo))] >> (x - kLo)) & 1u;
+}
+
+// One-sided derivatives along axis a at tile voxel l. Samples beyond the band's edge hold
+// +-W h, not values of the field; where the stencil reaches them they are replaced by
+// extrapolation from the active samples on the line (quadratic through the last three, linear
+// through the last two), so that voxels near the edge still see a smooth field.
+OneSided one_sided_in_band(const Scratch& s, const Coord& l, int a, const float* v, Scheme scheme) {
+  const int reach = stencil_reach(scheme);
+  int lo = 0, hi = 0;  // active run around the centre: offsets [lo, hi]
+  for (int k = 1; k <= reach; ++k) {
+    Coord q = l;
+    q[a] += k;
+    if (!active_at(s, q.x, q.y, q.z)) break;
+    hi = k;
+  }
+  for (int k = 1; k <= reach; ++k) {
+    Coord q = l;
+    q[a] -= k;
+    if (!active_at(s, q.x, q.y, q.z)) break;
+    lo = -k;
+  }
+  if (hi == reach && lo == -reach) return one_sided(v, kStride[a], scheme);
+  double line[2 * kStencilReach + 1];
+  double* c = line + kStencilReach;
+  for (int k = lo; k <= hi; ++k) c[k] = double(v[k * kStride[a]]);
+  auto extend = [&](int from, int dir, int count) {
+    // Extrapolate c[from + dir], ..., from the run ending at `from` (run length count).
+    for (int k = from + dir; k >= -reach && k <= reach; k += dir) {
+      const double p1 = c[k - dir];
+      if (count >= 3) c[k] = 3 * p1 - 3 * c[k - 2 * dir] + c[k - 3 * dir];
+      else if (count == 2) c[k] = 2 * p1 - c[k - 2 * dir];
+      else c[k] = p1;
+      ++count;
+    }
+  };
+  const int run = hi - lo + 1;
+  extend(hi, 1, run);
+  extend(lo, -1, run);
+  return one_sided(c, 1, scheme);
+}
+
+struct OperatorSetup {
+  const EvolutionOptions& options;
+  double time = 0, kavg = 0;
+  const float* beta_a_override = nullptr;  // band value order (extension velocities)
+  const float* beta_p_override = nullptr;
+  bool want_edges = false;
+  bool want_betas = false;  // fill OperatorOutput::beta_a / beta_p
+};
+
+struct OperatorOutput {
+  std::vector<float> rate, beta_a, beta_p;
+  std::vector<std::uint8_t> edge;  // 1: an active voxel with an inactive 6-neighbour
+  double max_hyperbolic = 0, max_speed = 0, drift_sum = 0;
+  std::uint64_t drift_count = 0;
+};
+
+bool has_velocity(const EvolutionOptions& o) { return o.velocity.kind != Velocity::Kind::None; }
+bool has_speed(const EvolutionOptions& o) { return bool(o.speed.eval); }
+
+// The spatial operator on one brick: rates (and betas, edges) for its active voxels.
+void brick_operator(const NarrowBand& band, std::uint32_t b, const OperatorSetup& setup, Scratch& s,
+                    OperatorOutput& out, double& max_hyp, double& max_speed, double& drift_sum,
+                    std::uint64_t& drift_count) {
+  const EvolutionOptions& o = setup.options;
+  const SpeedFunction& speed = o.speed;
+  const bool moving = has_speed(o);
+  const bool advective = moving && speed.has_advective;
+  const bool parabolic = moving && speed.has_parabolic;
+  const bool velocity = has_velocity(o);
+  const std::uint32_t needs = moving ? speed.needs : 0u;
+  const bool upwind = advective || velocity;
+  const double h = band.voxel_size();
+  gather_box(band, b, kLo, kHi, s.tile, s.rows);
+  const Brick& br = band.bricks()[b];
+  const Coord origin = brick_origin(br.coord);
+  const std::size_t first = br.value_offset;
+  int k = 0;
+  br.active.for_each_set([&](int n) {
+    const Coord l = local_coord(n);
+    const float* v = s.tile.data() + tile_index(l.x, l.y, l.z);
+    s.d[std::size_t(k)] = *v;
+    Vec3d world{};
+    if ((needs & kNeedsPosition) || (velocity && o.velocity.kind == Velocity::Kind::Field)) {
+      world = band.world(origin + l);
+      s.x[std::size_t(k)] = float(world.x);
+      s.y[std::size_t(k)] = float(world.y);
+      s.z[std::size_t(k)] = float(world.z);
+    }
+    if (upwind)
+      for (int a = 0; a < 3; ++a) s.os[std::size_t(k)][std::size_t(a)] = one_sided_in_band(s, l, a, v, o.scheme);
+    Vec3d g{(double(v[1]) - double(v[-1])) / (2 * h), (double(v[kDim]) - double(v[-kDim])) / (2 * h),
+            (double(v[kDim * kDim]) - double(v[-kDim * kDim])) / (2 * h)};
+    const double gn = length(g);
+    if (needs & kNeedsPrincipal) {
+      const Curvature c = curvature_at(v, kStride, h);
+      s.mean[std::size_t(k)] = float(c.mean);
+      s.gauss[std::size_t(k)] = float(c.gauss);
+      s.k1[std::size_t(k)] = float(c.k1);
+      s.k2[std::size_t(k)] = float(c.k2);
+    } else if (needs & kNeedsMean) {
+      s.mean[std::size_t(k)] = float(mean_curvature_at(v, kStride, h));
+    }
+    s.grad[std::size_t(k)] = float(gn);
+    const Vec3d nrm = gn > 0 ? g / gn : Vec3d{};
+    s.nx[std::size_t(k)] = float(nrm.x);
+    s.ny[std::size_t(k)] = float(nrm.y);
+    s.nz[std::size_t(k)] = float(nrm.z);
+    if (velocity)
+      s.vel[std::size_t(k)] = o.velocity.kind == Velocity::Kind::Constant ? o.velocity.constant
+                                                                          : o.velocity.field(world, setup.time);
+    if (std::abs(*v) < 2 * h) {
+      drift_sum += std::abs(gn - 1.0);
+      ++drift_count;
+    }
+    if (setup.want_edges) {
+      bool edge = false;
+      for (int a = 0; a < 3; ++a)
+        for (int sgn = -1; sgn <= 1; sgn += 2) {
+          Coord q = l;
+          q[a] += sgn;
+          edge |= !active_at(s, q.x, q.y, q.z);
+        }
+      out.edge[first + std::size_t(k)] = edge ? 1 : 0;
+    }
+    ++k;
+  });
+  const int count = k;
+  if (moving) {
+    if (setup.beta_a_override) {
+      std::copy_n(setup.beta_a_override + first, count, s.beta_a.data());
+      std::copy_n(setup.beta_p_override + first, count, s.beta_p.data());
+    } else {
+      std::fill_n(s.beta_a.data(), count, 0.0f);
+      std::fill_n(s.beta_p.data(), count, 0.0f);
+      SpeedBatch batch;
+      batch.count = count;
+      batch.time = setup.time;
+      batch.h = h;
+      batch.kavg = setup.kavg;
+      batch.d = s.d.data();
+      if (needs & kNeedsPosition) {
+        batch.x = s.x.data();
+        batch.y = s.y.data();
+        batch.z = s.z.data();
+      }
+      if (needs & kNeedsNormal) {
+        batch.nx = s.nx.data();
+        batch.ny = s.ny.data();
+        batch.nz = s.nz.data();
+      }
+      if (needs & (kNeedsMean | kNeedsPrincipal)) batch.mean = s.mean.data();
+      if (needs & kNeedsPrincipal) {
+        batch.gauss = s.gauss.data();
+        batch.k1 = s.k1.data();
+        batch.k2 = s.k2.data();
+      }
+      if (needs & kNeedsGradNorm) batch.grad = s.grad.data();
+      speed.eval(batch, SpeedOutput{s.beta_a.data(), s.beta_p.data()});
+    }
+    if (setup.want_betas) {
+      std::copy_n(s.beta_a.data(), count, out.beta_a.data() + first);
+      std::copy_n(s.beta_p.data(), count, out.beta_p.data() + first);
+    }
+  }
+  const bool llf = o.hamiltonian == Hamiltonian::LaxFriedrichs;
+  for (int i = 0; i < count; ++i) {
+    const std::size_t u = std::size_t(i);
+    const double ba = advective ? double(s.beta_a[u]) : 0.0;
+    const double bp = parabolic ? double(s.beta_p[u]) : 0.0;
+    const Vec3d vel = velocity ? s.vel[u] : Vec3d{};
+    double rate = 0.0;
+    if (upwind) {
+      const OneSided* d = s.os[u].data();
+      const double vw[3] = {vel.x, vel.y, vel.z};
+      if (llf) {
+        const double alpha[3] = {std::abs(ba) + std::abs(vw[0]), std::abs(ba) + std::abs(vw[1]),
+                                 std::abs(ba) + std::abs(vw[2])};
+        rate -= llf_hamiltonian(d, ba, vw, alpha) / h;
+      } else {
+        if (advective && ba != 0.0) rate -= ba * godunov_gradient_norm(d, ba) / h;
+        if (velocity) rate -= upwind_advection(d, vw) / h;
+      }
+    }
+    if (parabolic) rate -= bp * double(s.grad[u]);
+    out.rate[first + u] = float(rate);
+    const double vsum = std::abs(vel.x) + std::abs(vel.y) + std::abs(vel.z);
+    max_hyp = std::max(max_hyp, kSqrt3 * std::abs(ba) + vsum);
+    max_speed = std::max(max_speed, std::abs(ba) + std::abs(bp) + length(vel));
+  }
+}
+
+// Area-weighted mean of H over the zero level: sum of H delta(u) |grad u| / sum of
+// delta(u) |grad u| over the band, with the smeared delta of width 1.5 h.
+double mean_curvature_average(const NarrowBand& band) {
+  const double h = band.voxel_size(), eps = 1.5 * h;
+  struct Acc {
+    double num = 0, den = 0;
+  };
+  tbb::combinable<Acc> acc;
+  tbb::enumerable_thread_specific<Scratch> scratch;
+  tbb::parallel_for(tbb::blocked_range<std::uint32_t>(0, std::uint32_t(band.brick_count()), 16),
+                    [&](const tbb::blocked_range<std::uint32_t>& r) {
+    Scratch& s = scratch.local();
+    Acc& a = acc.local();
+    for (std::uint32_t b = r.begin(); b != r.end(); ++b) {
+      const Brick& br = band.bricks()[b];
+      const float* vals = band.values().data() + br.value_offset;
+      bool any = false;
+      for (int i = 0; i < br.active_count() && !any; ++i) any = std::abs(double(vals[i])) < eps;
+      if (!any) continue;
+      gather_box(band, b, kLo, kHi, s.tile, {});
+      br.active.for_each_set([&](int n) {
+        const Coord l = local_coord(n);
+        const float* v = s.tile.data() + tile_index(l.x, l.y, l.z);
+        const double u = *v;
+        if (std::abs(u) >= eps) return;
+        const Vec3d g{(double(v[1]) - double(v[-1])) / (2 * h), (double(v[kDim]) - double(v[-kDim])) / (2 * h),
+                      (double(v[kDim * kDim]) - double(v[-kDim * kDim])) / (2 * h)};
+        const double w = (1.0 + std::cos(3.141592653589793 * u / eps)) / (2 * eps) * length(g);
+        a.num += w * mean_curvature_at(v, kStride, h);
+        a.den += w;
+      });
+    }
+  });
+  const Acc total = acc.combine([](const Acc& x, const Acc& y) { return Acc{x.num + y.num, x.den + y.den}; });
+  return total.den > 0 ? total.num / total.den : 0.0;
+}
+
+OperatorOutput run_operator(const NarrowBand& band, const OperatorSetup& setup) {
+  OperatorOutput out;
+  const std::size_t n = band.active_voxel_count();
+  out.rate.assign(n, 0.0f);
+  if (setup.want_betas) {
+    out.beta_a.assign(n, 0.0f);
+    out.beta_p.assign(n, 0.0f);
+  }
+  if (setup.want_edges) out.edge.assign(n, 0);
+  struct Stats {
+    double max_hyp = 0, max_speed = 0, drift_sum = 0;
+    std::uint64_t drift_count = 0;
+  };
+  tbb::combinable<Stats> stats;
+  tbb::enumerable_thread_specific<Scratch> scratch;
+  tbb::parallel_for(tbb::blocked_range<std::uint32_t>(0, std::uint32_t(band.brick_count()), 8),
+                    [&](const tbb::blocked_range<std::uint32_t>& r) {
+    Scratch& s = scratch.local();
+    Stats& st = stats.local();
+    for (std::uint32_t b = r.begin(); b != r.end(); ++b)
+      brick_operator(band, b, setup, s, out, st.max_hyp, st.max_speed, st.drift_sum, st.drift_count);
+  });
+  stats.combine_each([&](const Stats& st) {
+    out.max_hyperbolic = std::max(out.max_hyperbolic, st.max_hyp);
+    out.max_speed = std::max(out.max_speed, st.max_speed);
+    out.drift_sum += st.drift_sum;
+    out.drift_count += st.drift_count;
+  });
+  return out;
+}
+
+// Speeds extended from the zero level: each voxel takes the speeds at its closest point
+// x - u n (trilinear in the band's speeds; all 8 corners there are active for W >= 2).
+void extend_speeds(const NarrowBand& band, std::vector<float>& beta_a, std::vector<float>& beta_p) {
+  NarrowBand field_a = band, field_p = band;
+  std::vector<float> a = beta_a, p = beta_p;
+  field_a.swap_values(a);
+  field_p.swap_values(p);
+  const double h = band.voxel_size();
+  std::vector<float> ext_a(beta_a.size()), ext_p(beta_p.size());
+  tbb::enumerable_thread_specific<Scratch> scratch;
+  tbb::parallel_for(tbb::blocked_range<std::uint32_t>(0, std::uint32_t(band.brick_count()), 8),
+                    [&](const tbb::blocked_range<std::uint32_t>& r) {
+    Scratch& s = scratch.local();
+    BandAccessor acc_a(field_a), acc_p(field_p);
+    for (std::uint32_t b = r.begin(); b != r.end(); ++b) {
+      gather_box(band, b, kLo, kHi, s.tile, {});
+      const Brick& br = band.bricks()[b];
+      const Coord origin = brick_origin(br.coord);
+      std::size_t k = br.value_offset;
+      br.active.for_each_set([&](int n) {
+        const Coord l = local_coord(n);
+        const float* v = s.tile.data() + tile_index(l.x, l.y, l.z);
+        const Vec3d g{(double(v[1]) - double(v[-1])) / (2 * h), (double(v[kDim]) - double(v[-kDim])) / (2 * h),
+                      (double(v[kDim * kDim]) - double(v[-kDim * kDim])) / (2 * h)};
+        const double gn = length(g);
+        const Vec3d x = band.world(origin + l);
+        const Vec3d c = gn > 1e-12 ? x - g * (double(*v) / (gn * gn)) : x;
+        ext_a[k] = sample_trilinear(acc_a, field_a, c);
+        ext_p[k] = sample_trilinear(acc_p, field_p, c);
+        ++k;
+      });
+    }
+  });
+  beta_a.swap(ext_a);
+  beta_p.swap(ext_p);
+}
+
+void check_options(const NarrowBand& band, const EvolutionOptions& o) {
+  auto bad = [](const std::string& why) { throw Error(ErrorCode::InvalidArgument, "evolve", why); };
+  if (!has_speed(o) && !has_velocity(o)) bad("no motion: give a speed or a velocity");
+  if (o.velocity.kind == Velocity::Kind::Field && !o.velocity.field) bad("velocity field without a function");
+  if (o.velocity.kind == Velocity::Kind::Constant && !isfinite(o.velocity.constant)) bad("velocity must be finite");
+  if ((o.steps > 0) == (o.time > 0)) bad("give exactly one of steps > 0 or time > 0");
+  if (o.steps < 0 || !(o.time >= 0) || !std::isfinite(o.time)) bad("steps and time must be >= 0 and finite");
+  if (!(o.cfl > 0 && o.cfl <= 1)) bad("cfl must be in (0, 1]");
+  if (o.rk_order != 1 && o.rk_order != 3) bad("rk_order must be 1 or 3");
+  if (o.redistance_every < 0 || !(o.drift_tolerance >= 0) || o.max_steps < 1) bad("negative redistance_every, drift_tolerance or max_steps");
+  if (has_speed(o) && (!std::isfinite(o.speed.diffusion) || o.speed.diffusion < 0)) bad("speed diffusion bound must be >= 0");
+  if (band.half_width() < 2.0) bad("the band half-width must be at least 2 voxels");
+}
+
+// First non-finite value, as "voxel (x, y, z)"; empty when all are finite.
+std::string first_non_finite(const NarrowBand& band, const std::vector<float>& values) {
+  std::atomic<std::size_t> at{std::numeric_limits<std::size_t>::max()};
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, values.size(), 1 << 14), [&](const tbb::blocked_range<std::size_t>& r) {
+    for (std::size_t i = r.begin(); i != r.end(); ++i)
+      if (!std::isfinite(values[i])) {
+        std::size_t cur = at.load();
+        while (i < cur && !at.compare_exchange_weak(cur, i)) {
+        }
+        break;
+      }
+  });
+  const std::size_t i = at.load();
+  if (i == std::numeric_limits<std::size_t>::max()) return {};
+  std::size_t k = 0;
+  std::string where;
+  band.for_each_active([&](const Coord& c, float) {
+    if (k++ == i) where = "voxel (" + std::to_string(c.x) + ", " + std::to_string(c.y) + ", " + std::to_string(c.z) + ")";
+  });
+  return where;
+}
+
+}  // namespace
+
+OperatorResult evaluate_operator(const NarrowBand& band, const EvolutionOptions& options, double time) {
+  OperatorSetup setup{options};
+  setup.time = time;
+  if (has_speed(options) && (options.speed.needs & kNeedsMeanAverage)) setup.kavg = mean_curvature_average(band);
+  OperatorOutput out = run_operator(band, setup);
+  OperatorResult r;
+  r.rate = std::move(out.rate);
+  r.max_hyperbolic = out.max_hyperbolic;
+  r.max_speed = out.max_speed;
+  r.grad_drift = out.drift_count ? out.drift_sum / double(out.drift_count) : 0.0;
+  return r;
+}
+
+EvolutionResult evolve(const NarrowBand& band, const EvolutionOptions& options) {
+  check_options(band, options);
+  const auto start = Clock::now();
+  const double h = band.voxel_size();
+  const double half_width = band.half_width();
+  const double diffusion = has_speed(options) && options.speed.has_parabolic ? options.speed.diffusion : 0.0;
+  EvolutionResult result;
+  result.band = band;
+  NarrowBand& cur = result.band;
+  double t = 0;
+  int steps_since_redistance = 0;
+  for (int step = 1; step <= options.max_steps; ++step) {
+    if (options.steps > 0 && step > options.steps) break;
+    if (options.time > 0 && t >= options.time) break;
+    if (options.progress.cancelled()) {
+      result.stop = StopReason::Cancelled;
+      result.message = "cancelled after " + std::to_string(result.steps) + " steps";
+      break;
+    }
+    // Stage 1 (and the speeds, extended when asked).
+    auto t0 = Clock::now();
+    OperatorSetup setup{options};
+    setup.time = t;
+    setup.want_edges = true;
+    setup.want_betas = options.extension && has_speed(options);
+    if (has_speed(options) && (options.speed.needs & kNeedsMeanAverage)) setup.kavg = mean_curvature_average(cur);
+    OperatorOutput op = run_operator(cur, setup);
+    if (setup.want_betas) {
+      extend_speeds(cur, op.beta_a, op.beta_p);
+      OperatorSetup ext = setup;
+      ext.beta_a_override = op.beta_a.data();
+      ext.beta_p_override = op.beta_p.data();
+      std::vector<std::uint8_t> edge = std::move(op.edge);
+      op = run_operator(cur, ext);
+      op.edge = std::move(edge);
+    }
+    result.seconds.operator_eval += since(t0);
+    const double grad_drift = op.drift_count ? op.drift_sum / double(op.drift_count) : 0.0;
+    const double rate_limit = op.max_hyperbolic / h + 6.0 * diffusion / (h * h);
+    double dt = rate_limit > 0 ? options.cfl / rate_limit : options.cfl * h;
+    if (options.time > 0) dt = std::min(dt, options.time - t);
+
+    // RK stages; land mines halve dt and retry.
+    std::vector<float> next;
+    bool mine = false;
+    for (int attempt = 0; attempt < 5; ++attempt) {
+      auto t1 = Clock::now();
+      const std::vector<float> u0(cur.values().begin(), cur.values().end());
+      next.resize(u0.size());
+      for (std::size_t i = 0; i < u0.size(); ++i) next[i] = float(double(u0[i]) + dt * double(op.rate[i]));
+      if (options.rk_order == 3) {
+        NarrowBand stage = cur;
+        OperatorSetup s2 = setup;
+        s2.want_edges = false;
+        s2.want_betas = false;
+        std::vector<float> u1 = next;
+        stage.swap_values(u1);
+        s2.time = t + dt;
+        auto t2 = Clock::now();
+        std::vector<float> r1 = run_operator(stage, s2).rate;
+        result.seconds.operator_eval += since(t2);
+        std::vector<float> u2(u0.size());
+        for (std::size_t i = 0; i < u0.size(); ++i)
+          u2[i] = float(0.75 * u0[i] + 0.25 * (double(next[i]) + dt * double(r1[i])));
+        std::vector<float> tmp = u2;
+        stage.swap_values(tmp);
+        s2.time = t + 0.5 * dt;
+        t2 = Clock::now();
+        std::vector<float> r2 = run_operator(stage, s2).rate;
+        result.seconds.operator_eval += since(t2);
+        for (std::size_t i = 0; i < u0.size(); ++i)
+          next[i] = float(u0[i] / 3.0 + 2.0 / 3.0 * (double(u2[i]) + dt * double(r2[i])));
+      }
+      mine = false;
+      for (std::size_t i = 0; i < u0.size() && !mine; ++i)
+        mine = op.edge[i] && ((u0[i] < 0.0f) != (next[i] < 0.0f));
+      result.seconds.update += since(t1);
+      if (!mine || attempt == 4) break;
+      ++result.landmine_count;
+      dt *= 0.5;
+    }
+    const std::string bad = first_non_finite(cur, next);
+    if (!bad.empty()) {
+      result.stop = StopReason::NonFinite;
+      std::ostringstream msg;
+      msg << "a non-finite value at " << bad << " in step " << step << " (t = " << t << ", dt = " << dt
+          << "); the band is the state after step " << result.steps;
+      result.message = msg.str();
+      break;
+    }
+    auto t3 = Clock::now();
+    NarrowBand moved = cur;
+    moved.swap_values(next);
+    TrackOptions track;
+    track.half_width = half_width;
+    TrackResult tracked = track_band(moved, track);
+    result.activated += tracked.activated;
+    result.retired += tracked.retired;
+    result.seconds.tracking += since(t3);
+    ++steps_since_redistance;
+    const bool due = mine || (options.redistance_every > 0 && steps_since_redistance >= options.redistance_every) ||
+                     (options.drift_tolerance > 0 && grad_drift > options.drift_tolerance);
+    if (due) {
+      auto t4 = Clock::now();
+      RedistanceOptions ro;
+      ro.half_width = half_width;
+      tracked.band = redistance(tracked.band, ro).band;
+      ++result.redistance_count;
+      steps_since_redistance = 0;
+      result.seconds.redistance += since(t4);
+    }
+    cur = std::move(tracked.band);
+    t += dt;
+    result.steps = step;
+    result.time = t;
+    result.grad_drift = grad_drift;
+    StepInfo info;
+    info.step = step;
+    info.time = t;
+    info.dt = dt;
+    info.active_voxels = cur.active_voxel_count();
+    info.max_speed = op.max_speed;
+    info.redistance_count = result.redistance_count;
+    info.landmine_count = result.landmine_count;
+    info.grad_drift = grad_drift;
+    info.elapsed_seconds = since(start);
+    if (options.on_step) options.on_step(info);
+    if (options.progress.on_progress) {
+      const double f = options.steps > 0 ? double(step) / options.steps : t / options.time;
+      options.progress.on_progress(std::min(1.0, f), "evolve");
+    }
+  }
+  result.seconds.total = since(start);
+  return result;
+}
+
+}  // namespace levelset::evolve
