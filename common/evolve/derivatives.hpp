@@ -30,6 +30,7 @@
 #pragma once
 
 #include <algorithm>
+#include <limits>
 #include <cmath>
 #include <cstddef>
 
@@ -56,20 +57,31 @@ inline double eno2_correction(double a, double b) { return std::abs(a) <= std::a
 
 // HJ-WENO5 from the five differences v1..v5 (O&F eq. 3.25-3.35); v3 is the difference across
 // the upwind interval, v1 the farthest upwind.
-inline double weno5(double v1, double v2, double v3, double v4, double v5) {
-  const double phi1 = v1 / 3.0 - 7.0 * v2 / 6.0 + 11.0 * v3 / 6.0;
-  const double phi2 = -v2 / 6.0 + 5.0 * v3 / 6.0 + v4 / 3.0;
-  const double phi3 = v3 / 3.0 + 5.0 * v4 / 6.0 - v5 / 6.0;
-  const double a1 = v1 - 2.0 * v2 + v3, b1 = v1 - 4.0 * v2 + 3.0 * v3;
-  const double a2 = v2 - 2.0 * v3 + v4, b2 = v2 - v4;
-  const double a3 = v3 - 2.0 * v4 + v5, b3 = 3.0 * v3 - 4.0 * v4 + v5;
-  const double s1 = 13.0 / 12.0 * a1 * a1 + 0.25 * b1 * b1;
-  const double s2 = 13.0 / 12.0 * a2 * a2 + 0.25 * b2 * b2;
-  const double s3 = 13.0 / 12.0 * a3 * a3 + 0.25 * b3 * b3;
-  const double vmax = std::max({v1 * v1, v2 * v2, v3 * v3, v4 * v4, v5 * v5});
-  const double eps = 1e-6 * vmax + 1e-99;
-  const double e1 = s1 + eps, e2 = s2 + eps, e3 = s3 + eps;
-  const double w1 = 0.1 / (e1 * e1), w2 = 0.6 / (e2 * e2), w3 = 0.3 / (e3 * e3);
+template <class R>
+[[gnu::always_inline]] inline R weno5(R v1, R v2, R v3, R v4, R v5) {
+  // Divisions by constants written as products (no -ffast-math here); 4 divisions left.
+  constexpr R k3 = R(1) / R(3), k6 = R(1) / R(6), k1312 = R(13) / R(12);
+  const R phi1 = k3 * v1 - R(7) * k6 * v2 + R(11) * k6 * v3;
+  const R phi2 = -k6 * v2 + R(5) * k6 * v3 + k3 * v4;
+  const R phi3 = k3 * v3 + R(5) * k6 * v4 - k6 * v5;
+  const R a1 = v1 - R(2) * v2 + v3, b1 = v1 - R(4) * v2 + R(3) * v3;
+  const R a2 = v2 - R(2) * v3 + v4, b2 = v2 - v4;
+  const R a3 = v3 - R(2) * v4 + v5, b3 = R(3) * v3 - R(4) * v4 + v5;
+  const R s1 = k1312 * a1 * a1 + R(0.25) * b1 * b1;
+  const R s2 = k1312 * a2 * a2 + R(0.25) * b2 * b2;
+  const R s3 = k1312 * a3 * a3 + R(0.25) * b3 * b3;
+  const R vmax = std::max({v1 * v1, v2 * v2, v3 * v3, v4 * v4, v5 * v5});
+  // The tiny term keeps 0/0 away for all-zero differences; its square must not underflow.
+  const R eps = R(1e-6) * vmax + (sizeof(R) == sizeof(double) ? R(1e-99) : R(1e-18));
+  const R e1 = s1 + eps, e2 = s2 + eps, e3 = s3 + eps;
+  // Weights d_k / e_k^2 times e1^2 e2^2 e3^2: one division instead of four. Where that
+  // product under- or overflows (all-zero or extreme differences), the plain form.
+  const R q1 = e2 * e3, q2 = e1 * e3, q3 = e1 * e2;
+  const R W1 = R(0.1) * q1 * q1, W2 = R(0.6) * q2 * q2, W3 = R(0.3) * q3 * q3;
+  const R sum = W1 + W2 + W3;
+  if (sum > std::numeric_limits<R>::min() && sum < std::numeric_limits<R>::max())
+    return (W1 * phi1 + W2 * phi2 + W3 * phi3) / sum;
+  const R w1 = R(0.1) / (e1 * e1), w2 = R(0.6) / (e2 * e2), w3 = R(0.3) / (e3 * e3);
   return (w1 * phi1 + w2 * phi2 + w3 * phi3) / (w1 + w2 + w3);
 }
 
@@ -91,7 +103,7 @@ inline OneSided one_sided(const T* v, std::ptrdiff_t s) {
     const double um3 = double(v[-3 * s]), up3 = double(v[3 * s]);
     const double d_m3 = um2 - um3, d_m2 = um1 - um2, d_m1 = u0 - um1;  // D+u at i-3, i-2, i-1
     const double d_0 = up1 - u0, d_p1 = up2 - up1, d_p2 = up3 - up2;   // D+u at i, i+1, i+2
-    return {weno5(d_m3, d_m2, d_m1, d_0, d_p1), weno5(d_p2, d_p1, d_0, d_m1, d_m2)};
+    return {weno5<double>(d_m3, d_m2, d_m1, d_0, d_p1), weno5<double>(d_p2, d_p1, d_0, d_m1, d_m2)};
   }
 }
 
@@ -125,6 +137,27 @@ inline OneSided one_sided(const float* v, std::ptrdiff_t stride) {
 // All three axes at once: d[a] along stride[a] (x, y, z).
 inline void one_sided_xyz(const float* v, const std::ptrdiff_t stride[3], Scheme s, OneSided d[3]) {
   for (int a = 0; a < 3; ++a) d[a] = one_sided(v, stride[a], s);
+}
+
+// One side only: D-u (minus = true) or D+u, for pure advection, which upwinds each axis by
+// the sign of the velocity and never needs the other side (half the work of one_sided).
+inline double one_side(const float* v, std::ptrdiff_t s, Scheme scheme, bool minus) {
+  const double u0 = double(v[0]);
+  const std::ptrdiff_t t = minus ? -s : s;  // towards the upwind side
+  const double a1 = double(v[t]);
+  const double first = minus ? u0 - a1 : a1 - u0;
+  if (scheme == Scheme::Upwind1) return first;
+  const double b1 = double(v[-t]), a2 = double(v[2 * t]);
+  if (scheme == Scheme::Eno2) {
+    // Same as one_sided's ENO2 side, mirrored for D+.
+    const double far = 0.5 * (a2 - 2.0 * a1 + u0), mid = 0.5 * (a1 - 2.0 * u0 + b1);
+    return minus ? first + detail::eno2_correction(far, mid) : first - detail::eno2_correction(mid, far);
+  }
+  const double b2 = double(v[-2 * t]), a3 = double(v[3 * t]);
+  // Differences ordered from the far upwind side: for D- these are D+u at i-3 .. i+1.
+  const double d1 = minus ? a2 - a3 : a3 - a2, d2 = minus ? a1 - a2 : a2 - a1, d3 = first;
+  const double d4 = minus ? b1 - u0 : u0 - b1, d5 = minus ? b2 - b1 : b1 - b2;
+  return detail::weno5<double>(d1, d2, d3, d4, d5);
 }
 
 // Godunov's upwind |grad u| for u_t + beta |grad u| = 0, value units per voxel; 0 for beta == 0.

@@ -6,6 +6,7 @@
 #include <chrono>
 #include <cmath>
 #include <limits>
+#include <memory>
 #include <span>
 #include <sstream>
 
@@ -41,6 +42,7 @@ struct Scratch {
   std::vector<std::uint32_t> rows = std::vector<std::uint32_t>(std::size_t(kDim) * kDim);
   std::array<float, kBrickVoxels> d, x, y, z, nx, ny, nz, mean, gauss, k1, k2, grad, beta_a, beta_p;
   std::array<std::array<OneSided, 3>, kBrickVoxels> os;
+  std::unique_ptr<struct AxisLines> lines;
   std::array<Vec3d, kBrickVoxels> vel;
 };
 
@@ -48,43 +50,145 @@ bool active_at(const Scratch& s, int x, int y, int z) {
   return (s.rows[std::size_t((y - kLo) + kDim * (z - kLo))] >> (x - kLo)) & 1u;
 }
 
-// One-sided derivatives along axis a at tile voxel l. Samples beyond the band's edge hold
-// +-W h, not values of the field; where the stencil reaches them they are replaced by
-// extrapolation from the active samples on the line (quadratic through the last three, linear
-// through the last two), so that voxels near the edge still see a smooth field.
-OneSided one_sided_in_band(const Scratch& s, const Coord& l, int a, const float* v, Scheme scheme) {
-  const int reach = stencil_reach(scheme);
-  int lo = 0, hi = 0;  // active run around the centre: offsets [lo, hi]
-  for (int k = 1; k <= reach; ++k) {
-    Coord q = l;
-    q[a] += k;
-    if (!active_at(s, q.x, q.y, q.z)) break;
-    hi = k;
-  }
-  for (int k = 1; k <= reach; ++k) {
-    Coord q = l;
-    q[a] -= k;
-    if (!active_at(s, q.x, q.y, q.z)) break;
-    lo = -k;
-  }
-  if (hi == reach && lo == -reach) return one_sided(v, kStride[a], scheme);
-  double line[2 * kStencilReach + 1];
-  double* c = line + kStencilReach;
-  for (int k = lo; k <= hi; ++k) c[k] = double(v[k * kStride[a]]);
-  auto extend = [&](int from, int dir, int count) {
-    // Extrapolate c[from + dir], ..., from the run ending at `from` (run length count).
-    for (int k = from + dir; k >= -reach && k <= reach; k += dir) {
-      const double p1 = c[k - dir];
-      if (count >= 3) c[k] = 3 * p1 - 3 * c[k - 2 * dir] + c[k - 3 * dir];
-      else if (count == 2) c[k] = 2 * p1 - c[k - 2 * dir];
-      else c[k] = p1;
-      ++count;
+// The band's edge layer is not evolved by the PDE (its stencils read +-W h beyond the band):
+// after each step an edge voxel takes the polynomial extrapolation of the new values along
+// the axis direction where u changes fastest: sum of coef[k] * u[source[k]].
+struct EdgeStencil {
+  std::uint32_t target = 0;
+  std::uint8_t count = 0;
+  std::array<std::uint32_t, 3> source{};
+  std::array<float, 3> coef{};
+};
+
+bool is_edge(const Scratch& s, const Coord& l) {
+  for (int a = 0; a < 3; ++a)
+    for (int sgn = -1; sgn <= 1; sgn += 2) {
+      Coord q = l;
+      q[a] += sgn;
+      if (!active_at(s, q.x, q.y, q.z)) return true;
     }
-  };
-  const int run = hi - lo + 1;
-  extend(hi, 1, run);
-  extend(lo, -1, run);
-  return one_sided(c, 1, scheme);
+  return false;
+}
+
+// Band value index of the active voxel at brick-local coordinates q (within one brick of the
+// brick itself).
+std::uint32_t value_index(const NarrowBand& band, const Neighborhood& around, const Coord& q) {
+  const int bx = q.x < 0 ? -1 : (q.x >= kBrickDim ? 1 : 0), by = q.y < 0 ? -1 : (q.y >= kBrickDim ? 1 : 0),
+            bz = q.z < 0 ? -1 : (q.z >= kBrickDim ? 1 : 0);
+  const Brick& br = band.bricks()[around[std::size_t(Neighborhood::slot(bx, by, bz))]];
+  return std::uint32_t(br.value_offset + std::uint32_t(br.slot(local_index(q.x & 7, q.y & 7, q.z & 7))));
+}
+
+// The extrapolation of edge voxel l from the interior (see EdgeStencil): quadratic through the
+// next three active voxels along a direction (linear through two), the first one not itself
+// an edge voxel, on the direction where u changes fastest.
+EdgeStencil edge_stencil(const NarrowBand& band, const Neighborhood& around, const Scratch& s, const Coord& l) {
+  EdgeStencil e;
+  double step = -1.0;
+  for (int f = 0; f < 6; ++f) {
+    const int a = f >> 1, dir = (f & 1) ? 1 : -1;
+    Coord q[3] = {l, l, l};
+    int n = 0;
+    for (; n < 3; ++n) {
+      q[n][a] += dir * (n + 1);
+      if (n + 1 > kStencilReach || !active_at(s, q[n].x, q[n].y, q[n].z)) break;
+    }
+    if (n < 2 || is_edge(s, q[0])) continue;
+    const float* t = s.tile.data();
+    const double u1 = t[tile_index(q[0].x, q[0].y, q[0].z)], u2 = t[tile_index(q[1].x, q[1].y, q[1].z)];
+    if (std::abs(u1 - u2) <= step) continue;
+    step = std::abs(u1 - u2);
+    e.count = std::uint8_t(n);
+    for (int k = 0; k < n; ++k) e.source[std::size_t(k)] = value_index(band, around, q[k]);
+    e.coef = n == 3 ? std::array<float, 3>{3.0f, -3.0f, 1.0f} : std::array<float, 3>{2.0f, -1.0f, 0.0f};
+  }
+  return e;
+}
+
+// Lines of samples along each axis through the brick's voxels, with the samples beyond the
+// band's edge (which hold +-W h, not values of the field) replaced by extrapolation from the
+// active samples of the line (quadratic through the last three, linear through two), so that
+// upwind stencils near the edge see a smooth field. line(a, i, j)[k] is the sample at
+// coordinate k - kStencilReach along axis a (k in [0, 14)), at (i, j) in [0, 8)^2 across.
+struct AxisLines {
+  static constexpr int kLen = kDim;
+  std::array<float, 3 * kBrickDim * kBrickDim * kLen> data{};
+  float* line(int a, int i, int j) { return data.data() + std::size_t(((a * kBrickDim + i) * kBrickDim + j) * kLen); }
+  const float* line(int a, int i, int j) const {
+    return data.data() + std::size_t(((a * kBrickDim + i) * kBrickDim + j) * kLen);
+  }
+};
+
+// Fills one line: `active` bit k says sample k is in the band.
+void extrapolate_line(float* v, std::uint32_t active, int reach) {
+  constexpr int n = AxisLines::kLen;
+  int k = 0;
+  while (k < n) {
+    if ((active >> k) & 1u) {
+      ++k;
+      continue;
+    }
+    // Inactive run [k, e).
+    int e = k;
+    while (e < n && !((active >> e) & 1u)) ++e;
+    const bool left = k > 0, right = e < n;
+    for (int g = k; g < e; ++g) {
+      const int dl = g - k + 1, dr = e - g;  // distance to the nearest active sample on each side
+      const bool from_left = left && (!right || dl <= dr);
+      if ((from_left ? dl : dr) > reach || (!left && !right)) continue;
+      const int dir = from_left ? 1 : -1, last = from_left ? k - 1 : e;  // last active sample
+      // Active samples behind `last`, away from the gap (at most 3).
+      int run = 1;
+      while (run < 3) {
+        const int q = last - dir * run;
+        if (q < 0 || q >= n || !((active >> q) & 1u)) break;
+        ++run;
+      }
+      const double p1 = v[last], p2 = run >= 2 ? v[last - dir] : p1, p3 = run >= 3 ? v[last - 2 * dir] : p2;
+      const double t = from_left ? dl : dr;  // steps beyond `last`
+      // Polynomial through (0, p1), (-1, p2), (-2, p3) evaluated at t.
+      double value = p1;
+      if (run == 2) value = p1 + t * (p1 - p2);
+      if (run >= 3) value = p1 + t * (1.5 * p1 - 2.0 * p2 + 0.5 * p3) + 0.5 * t * t * (p1 - 2.0 * p2 + p3);
+      v[g] = float(value);
+    }
+    k = e;
+  }
+}
+
+void fill_axis_lines(const Scratch& s, int reach, AxisLines& lines) {
+  constexpr int n = AxisLines::kLen;
+  constexpr std::uint32_t all = (1u << n) - 1, own = ((1u << kBrickDim) - 1) << (-kLo);  // brick samples
+  auto row = [&](int ty, int tz) { return s.rows[std::size_t(ty + kDim * tz)]; };  // tile-index rows
+  for (int i = 0; i < kBrickDim; ++i)
+    for (int j = 0; j < kBrickDim; ++j) {
+      const int ti = i - kLo, tj = j - kLo;
+      // x lines: (y, z) = (i, j): one row.
+      {
+        const std::uint32_t act = row(ti, tj);
+        if (act & own) {
+          float* l = lines.line(0, i, j);
+          std::copy_n(s.tile.data() + tile_index(kLo, i, j), n, l);
+          if (act != all) extrapolate_line(l, act, reach);
+        }
+      }
+      // y lines: (x, z) = (i, j); z lines: (x, y) = (i, j).
+      std::uint32_t ay = 0, az = 0;
+      for (int k = 0; k < n; ++k) {
+        ay |= ((row(k, tj) >> ti) & 1u) << k;
+        az |= ((row(tj, k) >> ti) & 1u) << k;
+      }
+      if (ay & own) {
+        float* l = lines.line(1, i, j);
+        for (int k = 0; k < n; ++k) l[k] = s.tile[std::size_t(tile_index(i, k + kLo, j))];
+        if (ay != all) extrapolate_line(l, ay, reach);
+      }
+      if (az & own) {
+        float* l = lines.line(2, i, j);
+        for (int k = 0; k < n; ++k) l[k] = s.tile[std::size_t(tile_index(i, j, k + kLo))];
+        if (az != all) extrapolate_line(l, az, reach);
+      }
+    }
 }
 
 struct OperatorSetup {
@@ -99,7 +203,8 @@ struct OperatorSetup {
 struct OperatorOutput {
   std::vector<float> rate, beta_a, beta_p;
   std::vector<std::uint8_t> edge;  // 1: an active voxel with an inactive 6-neighbour
-  double max_hyperbolic = 0, max_speed = 0, drift_sum = 0;
+  std::vector<std::vector<EdgeStencil>> edge_stencils;  // per brick
+  double max_hyperbolic = 0, max_speed = 0, max_front_speed = 0, drift_sum = 0;
   std::uint64_t drift_count = 0;
 };
 
@@ -108,7 +213,7 @@ bool has_speed(const EvolutionOptions& o) { return bool(o.speed.eval); }
 
 // The spatial operator on one brick: rates (and betas, edges) for its active voxels.
 void brick_operator(const NarrowBand& band, std::uint32_t b, const OperatorSetup& setup, Scratch& s,
-                    OperatorOutput& out, double& max_hyp, double& max_speed, double& drift_sum,
+                    OperatorOutput& out, double& max_hyp, double& max_speed, double& max_front, double& drift_sum,
                     std::uint64_t& drift_count) {
   const EvolutionOptions& o = setup.options;
   const SpeedFunction& speed = o.speed;
@@ -118,8 +223,14 @@ void brick_operator(const NarrowBand& band, std::uint32_t b, const OperatorSetup
   const bool velocity = has_velocity(o);
   const std::uint32_t needs = moving ? speed.needs : 0u;
   const bool upwind = advective || velocity;
+  const bool advection_only = velocity && !advective && o.hamiltonian == Hamiltonian::Godunov;
   const double h = band.voxel_size();
-  gather_box(band, b, kLo, kHi, s.tile, s.rows);
+  const Neighborhood around = brick_neighborhood(band, b);
+  gather_box(band, around, kLo, kHi, s.tile, s.rows);
+  if (upwind) {
+    if (!s.lines) s.lines = std::make_unique<AxisLines>();
+    fill_axis_lines(s, stencil_reach(o.scheme), *s.lines);
+  }
   const Brick& br = band.bricks()[b];
   const Coord origin = brick_origin(br.coord);
   const std::size_t first = br.value_offset;
@@ -135,11 +246,34 @@ void brick_operator(const NarrowBand& band, std::uint32_t b, const OperatorSetup
       s.y[std::size_t(k)] = float(world.y);
       s.z[std::size_t(k)] = float(world.z);
     }
-    if (upwind)
-      for (int a = 0; a < 3; ++a) s.os[std::size_t(k)][std::size_t(a)] = one_sided_in_band(s, l, a, v, o.scheme);
-    Vec3d g{(double(v[1]) - double(v[-1])) / (2 * h), (double(v[kDim]) - double(v[-kDim])) / (2 * h),
-            (double(v[kDim * kDim]) - double(v[-kDim * kDim])) / (2 * h)};
-    const double gn = length(g);
+    if (velocity)
+      s.vel[std::size_t(k)] = o.velocity.kind == Velocity::Kind::Constant ? o.velocity.constant
+                                                                          : o.velocity.field(world, setup.time);
+    if (upwind) {
+      const AxisLines& ln = *s.lines;
+      auto& d = s.os[std::size_t(k)];
+      const float* lines[3] = {ln.line(0, l.y, l.z) + (l.x - kLo), ln.line(1, l.x, l.z) + (l.y - kLo),
+                               ln.line(2, l.x, l.y) + (l.z - kLo)};
+      if (advection_only) {
+        // Pure advection upwinds each axis by the velocity's sign: one side is enough.
+        const Vec3d& vel = s.vel[std::size_t(k)];
+        for (int a = 0; a < 3; ++a) {
+          const bool minus = vel[a] > 0.0;
+          const double side = vel[a] != 0.0 ? one_side(lines[a], 1, o.scheme, minus) : 0.0;
+          d[std::size_t(a)] = minus ? OneSided{side, 0.0} : OneSided{0.0, side};
+        }
+      } else {
+        for (int a = 0; a < 3; ++a) d[std::size_t(a)] = one_sided(lines[a], 1, o.scheme);
+      }
+    }
+    // Central gradient: for the parabolic part, normals, |grad u| and the drift near the front.
+    const bool near = std::abs(*v) < 2 * h;
+    const bool want_grad = parabolic || near || (needs & (kNeedsNormal | kNeedsGradNorm));
+    Vec3d g{};
+    if (want_grad)
+      g = Vec3d{double(v[1]) - double(v[-1]), double(v[kDim]) - double(v[-kDim]),
+                double(v[kDim * kDim]) - double(v[-kDim * kDim])} * (0.5 / h);
+    const double gn = want_grad ? length(g) : 0.0;
     if (needs & kNeedsPrincipal) {
       const Curvature c = curvature_at(v, kStride, h);
       s.mean[std::size_t(k)] = float(c.mean);
@@ -150,26 +284,23 @@ void brick_operator(const NarrowBand& band, std::uint32_t b, const OperatorSetup
       s.mean[std::size_t(k)] = float(mean_curvature_at(v, kStride, h));
     }
     s.grad[std::size_t(k)] = float(gn);
-    const Vec3d nrm = gn > 0 ? g / gn : Vec3d{};
-    s.nx[std::size_t(k)] = float(nrm.x);
-    s.ny[std::size_t(k)] = float(nrm.y);
-    s.nz[std::size_t(k)] = float(nrm.z);
-    if (velocity)
-      s.vel[std::size_t(k)] = o.velocity.kind == Velocity::Kind::Constant ? o.velocity.constant
-                                                                          : o.velocity.field(world, setup.time);
-    if (std::abs(*v) < 2 * h) {
+    if (needs & kNeedsNormal) {
+      const Vec3d nrm = gn > 0 ? g / gn : Vec3d{};
+      s.nx[std::size_t(k)] = float(nrm.x);
+      s.ny[std::size_t(k)] = float(nrm.y);
+      s.nz[std::size_t(k)] = float(nrm.z);
+    }
+    if (near) {
       drift_sum += std::abs(gn - 1.0);
       ++drift_count;
     }
-    if (setup.want_edges) {
-      bool edge = false;
-      for (int a = 0; a < 3; ++a)
-        for (int sgn = -1; sgn <= 1; sgn += 2) {
-          Coord q = l;
-          q[a] += sgn;
-          edge |= !active_at(s, q.x, q.y, q.z);
-        }
-      out.edge[first + std::size_t(k)] = edge ? 1 : 0;
+    if (setup.want_edges && is_edge(s, l)) {
+      out.edge[first + std::size_t(k)] = 1;
+      EdgeStencil e = edge_stencil(band, around, s, l);
+      if (e.count > 0) {
+        e.target = std::uint32_t(first + std::size_t(k));
+        out.edge_stencils[b].push_back(e);
+      }
     }
     ++k;
   });
@@ -234,7 +365,11 @@ void brick_operator(const NarrowBand& band, std::uint32_t b, const OperatorSetup
     out.rate[first + u] = float(rate);
     const double vsum = std::abs(vel.x) + std::abs(vel.y) + std::abs(vel.z);
     max_hyp = std::max(max_hyp, kSqrt3 * std::abs(ba) + vsum);
-    max_speed = std::max(max_speed, std::abs(ba) + std::abs(bp) + length(vel));
+    const double sp = std::abs(ba) + std::abs(bp) + length(vel);
+    max_speed = std::max(max_speed, sp);
+    // The front's speed: voxels next to the zero level only (curvatures blow up near the
+    // skeleton, deep in the band, without the front moving).
+    if (std::abs(s.d[u]) < 1.5 * h) max_front = std::max(max_front, sp);
   }
 }
 
@@ -283,9 +418,12 @@ OperatorOutput run_operator(const NarrowBand& band, const OperatorSetup& setup) 
     out.beta_a.assign(n, 0.0f);
     out.beta_p.assign(n, 0.0f);
   }
-  if (setup.want_edges) out.edge.assign(n, 0);
+  if (setup.want_edges) {
+    out.edge.assign(n, 0);
+    out.edge_stencils.resize(band.brick_count());
+  }
   struct Stats {
-    double max_hyp = 0, max_speed = 0, drift_sum = 0;
+    double max_hyp = 0, max_speed = 0, max_front = 0, drift_sum = 0;
     std::uint64_t drift_count = 0;
   };
   tbb::combinable<Stats> stats;
@@ -295,11 +433,12 @@ OperatorOutput run_operator(const NarrowBand& band, const OperatorSetup& setup) 
     Scratch& s = scratch.local();
     Stats& st = stats.local();
     for (std::uint32_t b = r.begin(); b != r.end(); ++b)
-      brick_operator(band, b, setup, s, out, st.max_hyp, st.max_speed, st.drift_sum, st.drift_count);
+      brick_operator(band, b, setup, s, out, st.max_hyp, st.max_speed, st.max_front, st.drift_sum, st.drift_count);
   });
   stats.combine_each([&](const Stats& st) {
     out.max_hyperbolic = std::max(out.max_hyperbolic, st.max_hyp);
     out.max_speed = std::max(out.max_speed, st.max_speed);
+    out.max_front_speed = std::max(out.max_front_speed, st.max_front);
     out.drift_sum += st.drift_sum;
     out.drift_count += st.drift_count;
   });
@@ -355,6 +494,7 @@ void check_options(const NarrowBand& band, const EvolutionOptions& o) {
   if (o.redistance_every < 0 || !(o.drift_tolerance >= 0) || o.max_steps < 1) bad("negative redistance_every, drift_tolerance or max_steps");
   if (has_speed(o) && (!std::isfinite(o.speed.diffusion) || o.speed.diffusion < 0)) bad("speed diffusion bound must be >= 0");
   if (band.half_width() < 2.0) bad("the band half-width must be at least 2 voxels");
+  if (!(o.track_distance > 0 && o.track_distance <= 1)) bad("track_distance must be in (0, 1] voxels");
 }
 
 // First non-finite value, as "voxel (x, y, z)"; empty when all are finite.
@@ -403,7 +543,7 @@ EvolutionResult evolve(const NarrowBand& band, const EvolutionOptions& options) 
   EvolutionResult result;
   result.band = band;
   NarrowBand& cur = result.band;
-  double t = 0;
+  double t = 0, motion = 0;
   int steps_since_redistance = 0;
   for (int step = 1; step <= options.max_steps; ++step) {
     if (options.steps > 0 && step > options.steps) break;
@@ -485,13 +625,30 @@ EvolutionResult evolve(const NarrowBand& band, const EvolutionOptions& options) 
       break;
     }
     auto t3 = Clock::now();
-    NarrowBand moved = cur;
-    moved.swap_values(next);
-    TrackOptions track;
-    track.half_width = half_width;
-    TrackResult tracked = track_band(moved, track);
-    result.activated += tracked.activated;
-    result.retired += tracked.retired;
+    // The edge layer from the new interior values (EdgeStencil), on its own side only.
+    std::vector<std::pair<std::uint32_t, float>> edge_values;
+    for (const std::vector<EdgeStencil>& list : op.edge_stencils)
+      for (const EdgeStencil& e : list) {
+        double v = 0;
+        for (int k = 0; k < e.count; ++k) v += double(e.coef[std::size_t(k)]) * double(next[e.source[std::size_t(k)]]);
+        if ((cur.values()[e.target] < 0.0f) == (v < 0.0)) edge_values.push_back({e.target, float(v)});
+      }
+    for (const auto& [i, v] : edge_values) next[i] = v;
+    // Band upkeep once the front may have moved track_distance voxels since the last one.
+    motion += op.max_front_speed * dt;
+    cur.swap_values(next);
+    TrackResult tracked;
+    if (mine || motion >= options.track_distance * h) {
+      TrackOptions track;
+      track.half_width = half_width;
+      tracked = track_band(cur, track);
+      result.activated += tracked.activated;
+      result.retired += tracked.retired;
+      ++result.band_updates;
+      motion = 0;
+    } else {
+      tracked.band = std::move(cur);
+    }
     result.seconds.tracking += since(t3);
     ++steps_since_redistance;
     const bool due = mine || (options.redistance_every > 0 && steps_since_redistance >= options.redistance_every) ||
@@ -525,6 +682,18 @@ EvolutionResult evolve(const NarrowBand& band, const EvolutionOptions& options) 
       const double f = options.steps > 0 ? double(step) / options.steps : t / options.time;
       options.progress.on_progress(std::min(1.0, f), "evolve");
     }
+  }
+  if (motion > 0) {
+    // Leave a tidy band: every value within W h, every voxel within W h of the front active.
+    auto t5 = Clock::now();
+    TrackOptions track;
+    track.half_width = half_width;
+    TrackResult tracked = track_band(cur, track);
+    result.activated += tracked.activated;
+    result.retired += tracked.retired;
+    ++result.band_updates;
+    cur = std::move(tracked.band);
+    result.seconds.tracking += since(t5);
   }
   result.seconds.total = since(start);
   return result;

@@ -22,8 +22,13 @@
 //   3. Land mines (thesis 2.4): a voxel at the band's edge (an inactive 6-neighbour) whose
 //      sign changed means the front reached the edge; the step is redone with dt / 2 (up
 //      to 4 times; counted), and the band is redistanced after it.
-//   4. Band upkeep (evolve/band_tracking.hpp): voxels the front approaches are activated,
-//      voxels it left retired, in work proportional to the band (no rebuild from a mesh).
+//   4. The band's edge layer (an inactive 6-neighbour) is not left to the PDE, whose
+//      stencils there read +-W h beyond the band: it takes the quadratic extrapolation of
+//      the new interior values along the axis nearest the normal, every step. Band upkeep
+//      (evolve/band_tracking.hpp: voxels the front approaches activated, voxels it left
+//      retired, in work proportional to the band, no rebuild from a mesh) runs once the
+//      front may have moved track_distance voxels since the last one (sum of
+//      dt * max |speed|), and after a land mine.
 //   5. Redistance (distance/redistance.hpp, fast sweeping, zero level kept) every
 //      redistance_every steps and whenever the mean ||grad u| - 1| over the voxels within
 //      2 h of the zero level exceeds drift_tolerance.
@@ -89,6 +94,7 @@ struct EvolutionOptions {
   int redistance_every = 0;     // 0: not by count
   double drift_tolerance = 0;   // 0: not by drift
   bool extension = false;
+  double track_distance = 0.5;  // voxels the front may move between band upkeeps, in (0, 1]
   std::function<void(const StepInfo&)> on_step;  // after every step, from the calling thread
   ProgressHook progress;        // fraction of steps / time; cancel checked between steps
 };
@@ -110,6 +116,7 @@ struct EvolutionResult {
   int redistance_count = 0;
   int landmine_count = 0;
   std::uint64_t activated = 0, retired = 0;  // by the band upkeep, all steps
+  int band_updates = 0;         // band upkeeps run
   double grad_drift = 0;        // at the last step
   StopReason stop = StopReason::Completed;
   std::string message;          // why it stopped early
