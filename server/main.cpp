@@ -116,7 +116,7 @@ int main(int argc, char** argv) {
       ->check(CLI::IsMember({"godunov", "llf"}));
   evolve_cmd->add_option("--rk", evolve.rk, "Time integration: 1 (forward Euler) or 3 (TVD-RK3)")
       ->check(CLI::IsMember({1, 3}));
-  evolve_cmd->add_option("--cfl", evolve.cfl, "CFL number in (0, 1]")->check(CLI::Range(1e-6, 1.0));
+  evolve_cmd->add_option("--cfl", evolve.cfl, "CFL number in (0, 1] (default 0.5 for --rk 1, 0.9 for --rk 3)")->check(CLI::Range(1e-6, 1.0));
   evolve_cmd->add_option("--redistance-every", evolve.redistance_every, "Redistance every K steps (0: never)")
       ->check(CLI::NonNegativeNumber);
   evolve_cmd->add_option("--drift-tolerance", evolve.drift_tolerance,

@@ -91,11 +91,22 @@ TrackResult track_band(const NarrowBand& moved, const TrackOptions& options) {
       step = std::abs(u1 - u2);
       best = 2.0f * u1 - u2;
       const int j3 = neighbor(b2, local_coord(j2), f, b3);
-      if (j3 < 0 || !old_active[b3].test(j3)) continue;
-      const float u3 = signed_at(b3, j3);
-      best = 3.0f * u1 - 3.0f * u2 + u3;
+      if (j3 >= 0 && old_active[b3].test(j3)) best = 3.0f * u1 - 3.0f * u2 + signed_at(b3, j3);
     }
-    return step >= 0.0f && (w.inside[b].test(i) ? best < 0.0f : best > 0.0f) ? std::abs(best) : -1.0f;
+    if (step < 0.0f || (w.inside[b].test(i) ? best >= 0.0f : best <= 0.0f)) return -1.0f;
+    // A distance changes by at most one voxel per voxel: clamp to the range every active
+    // 6-neighbour on the same side allows (a polynomial through a kink could leave it, and a
+    // value pushed beyond W would leave a hole next to the front).
+    float lo = 0.0f, hi = detail::kInf;
+    for (int f = 0; f < 6; ++f) {
+      std::size_t nb;
+      const int j = neighbor(b, l, f, nb);
+      if (j < 0 || !old_active[nb].test(j) || w.inside[nb].test(j) != w.inside[b].test(i)) continue;
+      const float d = w.values(std::uint32_t(nb))[j];
+      lo = std::max(lo, d - 1.0f);
+      hi = std::min(hi, d + 1.0f);
+    }
+    return std::clamp(std::abs(best), lo, std::max(lo, hi));
   };
   std::vector<std::vector<std::pair<int, float>>> edge_values(n);
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 32), [&](const tbb::blocked_range<std::size_t>& r) {
@@ -110,8 +121,10 @@ TrackResult track_band(const NarrowBand& moved, const TrackOptions& options) {
       for (const auto& [i, d] : edge_values[b]) w.values(std::uint32_t(b))[i] = d;
   });
 
-  // Newly reached voxels: extrapolated the same way (they are read by stencils next step), or
-  // one voxel beyond their nearest previously active 6-neighbour where no line of two exists.
+  // Newly reached voxels: the first-order Godunov distance update from their previously
+  // active 6-neighbours on the same side (exact for a plane; never below the nearest
+  // neighbour's distance, so a new voxel cannot look nearer the front than it is), replaced
+  // by the high-order extrapolation where the two agree.
   std::atomic<std::uint64_t> activated{0};
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 32), [&](const tbb::blocked_range<std::size_t>& r) {
     for (std::size_t b = r.begin(); b != r.end(); ++b) {
@@ -119,18 +132,19 @@ TrackResult track_band(const NarrowBand& moved, const TrackOptions& options) {
       std::uint64_t count = 0;
       w.domain[b].for_each_set([&](int i) {
         if (old_active[b].test(i)) return;
-        float best = extrapolate(b, i, false);
-        if (best < 0.0f) {
-          best = detail::kInf;
-          const Coord l = local_coord(i);
-          for (int f = 0; f < 6; ++f) {
-            std::size_t nb;
-            const int j = neighbor(b, l, f, nb);
-            // Only a neighbour on the same side (the front is never next to a new voxel).
-            if (j < 0 || !old_active[nb].test(j) || w.inside[nb].test(j) != w.inside[b].test(i)) continue;
-            best = std::min(best, w.values(std::uint32_t(nb))[j] + 1.0f);
-          }
+        const Coord l = local_coord(i);
+        float m[3] = {detail::kInf, detail::kInf, detail::kInf};
+        for (int f = 0; f < 6; ++f) {
+          std::size_t nb;
+          const int j = neighbor(b, l, f, nb);
+          if (j < 0 || !old_active[nb].test(j) || w.inside[nb].test(j) != w.inside[b].test(i)) continue;
+          m[f >> 1] = std::min(m[f >> 1], w.values(std::uint32_t(nb))[j]);
         }
+        // The high-order extrapolation where it agrees with that to half a voxel (smooth
+        // field; stencils near the edge read it), the Godunov value where it does not.
+        const float first_order = detail::godunov(m[0], m[1], m[2]);
+        const float high = extrapolate(b, i, false);
+        const float best = high >= 0.0f && std::abs(high - first_order) <= 0.5f ? high : first_order;
         d[i] = best;
         count += best <= float(w_half);
       });

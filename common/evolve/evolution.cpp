@@ -44,6 +44,7 @@ struct Scratch {
   std::array<std::array<OneSided, 3>, kBrickVoxels> os;
   std::unique_ptr<struct AxisLines> lines;
   std::array<Vec3d, kBrickVoxels> vel;
+  std::array<int, kBrickVoxels> tile_at;
 };
 
 bool active_at(const Scratch& s, int x, int y, int z) {
@@ -58,6 +59,10 @@ struct EdgeStencil {
   std::uint8_t count = 0;
   std::array<std::uint32_t, 3> source{};
   std::array<float, 3> coef{};
+  // The active 6-neighbours: a distance changes by at most h per voxel, so the result is
+  // clamped to the range they allow (a polynomial through a kink could leave it).
+  std::uint8_t neighbors = 0;
+  std::array<std::uint32_t, 6> neighbor{};
 };
 
 bool is_edge(const Scratch& s, const Coord& l) {
@@ -102,6 +107,12 @@ EdgeStencil edge_stencil(const NarrowBand& band, const Neighborhood& around, con
     for (int k = 0; k < n; ++k) e.source[std::size_t(k)] = value_index(band, around, q[k]);
     e.coef = n == 3 ? std::array<float, 3>{3.0f, -3.0f, 1.0f} : std::array<float, 3>{2.0f, -1.0f, 0.0f};
   }
+  if (e.count > 0)
+    for (int f = 0; f < 6; ++f) {
+      Coord q = l;
+      q[f >> 1] += (f & 1) ? 1 : -1;
+      if (active_at(s, q.x, q.y, q.z)) e.neighbor[e.neighbors++] = value_index(band, around, q);
+    }
   return e;
 }
 
@@ -191,6 +202,11 @@ void fill_axis_lines(const Scratch& s, int reach, AxisLines& lines) {
     }
 }
 
+// CPU seconds summed over threads, per phase of the spatial operator.
+struct OperatorSeconds {
+  double gradient = 0, curvature = 0, speed = 0, rates = 0;
+};
+
 struct OperatorSetup {
   const EvolutionOptions& options;
   double time = 0, kavg = 0;
@@ -206,6 +222,7 @@ struct OperatorOutput {
   std::vector<std::vector<EdgeStencil>> edge_stencils;  // per brick
   double max_hyperbolic = 0, max_speed = 0, max_front_speed = 0, drift_sum = 0;
   std::uint64_t drift_count = 0;
+  OperatorSeconds seconds;
 };
 
 bool has_velocity(const EvolutionOptions& o) { return o.velocity.kind != Velocity::Kind::None; }
@@ -214,7 +231,8 @@ bool has_speed(const EvolutionOptions& o) { return bool(o.speed.eval); }
 // The spatial operator on one brick: rates (and betas, edges) for its active voxels.
 void brick_operator(const NarrowBand& band, std::uint32_t b, const OperatorSetup& setup, Scratch& s,
                     OperatorOutput& out, double& max_hyp, double& max_speed, double& max_front, double& drift_sum,
-                    std::uint64_t& drift_count) {
+                    std::uint64_t& drift_count, OperatorSeconds& out_seconds) {
+  const auto t_start = Clock::now();
   const EvolutionOptions& o = setup.options;
   const SpeedFunction& speed = o.speed;
   const bool moving = has_speed(o);
@@ -274,15 +292,7 @@ void brick_operator(const NarrowBand& band, std::uint32_t b, const OperatorSetup
       g = Vec3d{double(v[1]) - double(v[-1]), double(v[kDim]) - double(v[-kDim]),
                 double(v[kDim * kDim]) - double(v[-kDim * kDim])} * (0.5 / h);
     const double gn = want_grad ? length(g) : 0.0;
-    if (needs & kNeedsPrincipal) {
-      const Curvature c = curvature_at(v, kStride, h);
-      s.mean[std::size_t(k)] = float(c.mean);
-      s.gauss[std::size_t(k)] = float(c.gauss);
-      s.k1[std::size_t(k)] = float(c.k1);
-      s.k2[std::size_t(k)] = float(c.k2);
-    } else if (needs & kNeedsMean) {
-      s.mean[std::size_t(k)] = float(mean_curvature_at(v, kStride, h));
-    }
+    s.tile_at[std::size_t(k)] = tile_index(l.x, l.y, l.z);
     s.grad[std::size_t(k)] = float(gn);
     if (needs & kNeedsNormal) {
       const Vec3d nrm = gn > 0 ? g / gn : Vec3d{};
@@ -305,6 +315,22 @@ void brick_operator(const NarrowBand& band, std::uint32_t b, const OperatorSetup
     ++k;
   });
   const int count = k;
+  const auto t_curvature = Clock::now();
+  out_seconds.gradient += std::chrono::duration<double>(t_curvature - t_start).count();
+  if (needs & kNeedsPrincipal) {
+    for (int i = 0; i < count; ++i) {
+      const Curvature c = curvature_at(s.tile.data() + s.tile_at[std::size_t(i)], kStride, h);
+      s.mean[std::size_t(i)] = float(c.mean);
+      s.gauss[std::size_t(i)] = float(c.gauss);
+      s.k1[std::size_t(i)] = float(c.k1);
+      s.k2[std::size_t(i)] = float(c.k2);
+    }
+  } else if (needs & kNeedsMean) {
+    for (int i = 0; i < count; ++i)
+      s.mean[std::size_t(i)] = float(mean_curvature_at(s.tile.data() + s.tile_at[std::size_t(i)], kStride, h));
+  }
+  const auto t_speed = Clock::now();
+  out_seconds.curvature += std::chrono::duration<double>(t_speed - t_curvature).count();
   if (moving) {
     if (setup.beta_a_override) {
       std::copy_n(setup.beta_a_override + first, count, s.beta_a.data());
@@ -342,6 +368,8 @@ void brick_operator(const NarrowBand& band, std::uint32_t b, const OperatorSetup
       std::copy_n(s.beta_p.data(), count, out.beta_p.data() + first);
     }
   }
+  const auto t_rates = Clock::now();
+  out_seconds.speed += std::chrono::duration<double>(t_rates - t_speed).count();
   const bool llf = o.hamiltonian == Hamiltonian::LaxFriedrichs;
   for (int i = 0; i < count; ++i) {
     const std::size_t u = std::size_t(i);
@@ -371,6 +399,7 @@ void brick_operator(const NarrowBand& band, std::uint32_t b, const OperatorSetup
     // skeleton, deep in the band, without the front moving).
     if (std::abs(s.d[u]) < 1.5 * h) max_front = std::max(max_front, sp);
   }
+  out_seconds.rates += since(t_rates);
 }
 
 // Area-weighted mean of H over the zero level: sum of H delta(u) |grad u| / sum of
@@ -425,6 +454,7 @@ OperatorOutput run_operator(const NarrowBand& band, const OperatorSetup& setup) 
   struct Stats {
     double max_hyp = 0, max_speed = 0, max_front = 0, drift_sum = 0;
     std::uint64_t drift_count = 0;
+    OperatorSeconds seconds;
   };
   tbb::combinable<Stats> stats;
   tbb::enumerable_thread_specific<Scratch> scratch;
@@ -433,12 +463,17 @@ OperatorOutput run_operator(const NarrowBand& band, const OperatorSetup& setup) 
     Scratch& s = scratch.local();
     Stats& st = stats.local();
     for (std::uint32_t b = r.begin(); b != r.end(); ++b)
-      brick_operator(band, b, setup, s, out, st.max_hyp, st.max_speed, st.max_front, st.drift_sum, st.drift_count);
+      brick_operator(band, b, setup, s, out, st.max_hyp, st.max_speed, st.max_front, st.drift_sum, st.drift_count,
+                     st.seconds);
   });
   stats.combine_each([&](const Stats& st) {
     out.max_hyperbolic = std::max(out.max_hyperbolic, st.max_hyp);
     out.max_speed = std::max(out.max_speed, st.max_speed);
     out.max_front_speed = std::max(out.max_front_speed, st.max_front);
+    out.seconds.gradient += st.seconds.gradient;
+    out.seconds.curvature += st.seconds.curvature;
+    out.seconds.speed += st.seconds.speed;
+    out.seconds.rates += st.seconds.rates;
     out.drift_sum += st.drift_sum;
     out.drift_count += st.drift_count;
   });
@@ -489,7 +524,7 @@ void check_options(const NarrowBand& band, const EvolutionOptions& o) {
   if (o.velocity.kind == Velocity::Kind::Constant && !isfinite(o.velocity.constant)) bad("velocity must be finite");
   if ((o.steps > 0) == (o.time > 0)) bad("give exactly one of steps > 0 or time > 0");
   if (o.steps < 0 || !(o.time >= 0) || !std::isfinite(o.time)) bad("steps and time must be >= 0 and finite");
-  if (!(o.cfl > 0 && o.cfl <= 1)) bad("cfl must be in (0, 1]");
+  if (!(o.cfl >= 0 && o.cfl <= 1)) bad("cfl must be in (0, 1] (0: the default)");
   if (o.rk_order != 1 && o.rk_order != 3) bad("rk_order must be 1 or 3");
   if (o.redistance_every < 0 || !(o.drift_tolerance >= 0) || o.max_steps < 1) bad("negative redistance_every, drift_tolerance or max_steps");
   if (has_speed(o) && (!std::isfinite(o.speed.diffusion) || o.speed.diffusion < 0)) bad("speed diffusion bound must be >= 0");
@@ -540,11 +575,18 @@ EvolutionResult evolve(const NarrowBand& band, const EvolutionOptions& options) 
   const double h = band.voxel_size();
   const double half_width = band.half_width();
   const double diffusion = has_speed(options) && options.speed.has_parabolic ? options.speed.diffusion : 0.0;
+  const double cfl = options.cfl > 0 ? options.cfl : (options.rk_order == 3 ? 0.9 : 0.5);
   EvolutionResult result;
   result.band = band;
   NarrowBand& cur = result.band;
   double t = 0, motion = 0;
   int steps_since_redistance = 0;
+  auto add_phases = [&](const OperatorOutput& op) {
+    result.seconds.gradient_cpu += op.seconds.gradient;
+    result.seconds.curvature_cpu += op.seconds.curvature;
+    result.seconds.speed_cpu += op.seconds.speed;
+    result.seconds.rates_cpu += op.seconds.rates;
+  };
   for (int step = 1; step <= options.max_steps; ++step) {
     if (options.steps > 0 && step > options.steps) break;
     if (options.time > 0 && t >= options.time) break;
@@ -561,6 +603,7 @@ EvolutionResult evolve(const NarrowBand& band, const EvolutionOptions& options) 
     setup.want_betas = options.extension && has_speed(options);
     if (has_speed(options) && (options.speed.needs & kNeedsMeanAverage)) setup.kavg = mean_curvature_average(cur);
     OperatorOutput op = run_operator(cur, setup);
+    add_phases(op);
     if (setup.want_betas) {
       extend_speeds(cur, op.beta_a, op.beta_p);
       OperatorSetup ext = setup;
@@ -568,12 +611,13 @@ EvolutionResult evolve(const NarrowBand& band, const EvolutionOptions& options) 
       ext.beta_p_override = op.beta_p.data();
       std::vector<std::uint8_t> edge = std::move(op.edge);
       op = run_operator(cur, ext);
+      add_phases(op);
       op.edge = std::move(edge);
     }
     result.seconds.operator_eval += since(t0);
     const double grad_drift = op.drift_count ? op.drift_sum / double(op.drift_count) : 0.0;
     const double rate_limit = op.max_hyperbolic / h + 6.0 * diffusion / (h * h);
-    double dt = rate_limit > 0 ? options.cfl / rate_limit : options.cfl * h;
+    double dt = rate_limit > 0 ? cfl / rate_limit : cfl * h;
     if (options.time > 0) dt = std::min(dt, options.time - t);
 
     // RK stages; land mines halve dt and retry.
@@ -593,7 +637,9 @@ EvolutionResult evolve(const NarrowBand& band, const EvolutionOptions& options) 
         stage.swap_values(u1);
         s2.time = t + dt;
         auto t2 = Clock::now();
-        std::vector<float> r1 = run_operator(stage, s2).rate;
+        OperatorOutput o1 = run_operator(stage, s2);
+        add_phases(o1);
+        std::vector<float> r1 = std::move(o1.rate);
         result.seconds.operator_eval += since(t2);
         std::vector<float> u2(u0.size());
         for (std::size_t i = 0; i < u0.size(); ++i)
@@ -602,7 +648,9 @@ EvolutionResult evolve(const NarrowBand& band, const EvolutionOptions& options) 
         stage.swap_values(tmp);
         s2.time = t + 0.5 * dt;
         t2 = Clock::now();
-        std::vector<float> r2 = run_operator(stage, s2).rate;
+        OperatorOutput o2 = run_operator(stage, s2);
+        add_phases(o2);
+        std::vector<float> r2 = std::move(o2.rate);
         result.seconds.operator_eval += since(t2);
         for (std::size_t i = 0; i < u0.size(); ++i)
           next[i] = float(u0[i] / 3.0 + 2.0 / 3.0 * (double(u2[i]) + dt * double(r2[i])));
@@ -631,7 +679,17 @@ EvolutionResult evolve(const NarrowBand& band, const EvolutionOptions& options) 
       for (const EdgeStencil& e : list) {
         double v = 0;
         for (int k = 0; k < e.count; ++k) v += double(e.coef[std::size_t(k)]) * double(next[e.source[std::size_t(k)]]);
-        if ((cur.values()[e.target] < 0.0f) == (v < 0.0)) edge_values.push_back({e.target, float(v)});
+        const bool inside = cur.values()[e.target] < 0.0f;
+        if (inside != (v < 0.0)) continue;
+        double lo = 0.0, hi = std::numeric_limits<double>::infinity();
+        for (int k = 0; k < e.neighbors; ++k) {
+          const double un = next[e.neighbor[std::size_t(k)]];
+          if ((un < 0.0) != inside) continue;
+          lo = std::max(lo, std::abs(un) - h);
+          hi = std::min(hi, std::abs(un) + h);
+        }
+        const double mag = std::clamp(std::abs(v), lo, std::max(lo, hi));
+        edge_values.push_back({e.target, float(inside ? -mag : mag)});
       }
     for (const auto& [i, v] : edge_values) next[i] = v;
     // Band upkeep once the front may have moved track_distance voxels since the last one.

@@ -15,7 +15,8 @@
 //      Local Lax-Friedrichs with alpha = |beta_a| + |V_a| when requested) and by upwinding
 //      for V; curvatures (evolve/curvature.hpp) by central differences, only those the speed
 //      needs, with the parabolic part on the central |grad u|.
-//   2. dt = cfl / (h_rate / h + 6 b / h^2) from the largest hyperbolic rate
+//   2. dt = cfl / (h_rate / h + 6 b / h^2) (cfl by default 0.5 for forward Euler, the
+//      thesis's h / (2 beta); 0.9 for TVD-RK3, which is stable there) from the largest hyperbolic rate
 //      (sqrt(3) |beta_a| + |V|_1) and the speed's diffusion bound b (thesis eq. 4.7 for the
 //      hyperbolic part; the explicit parabolic limit h^2 / (6 b)); for options.time the last
 //      step ends exactly at T. Forward Euler, or TVD-RK3 (Shu-Osher) with the same dt.
@@ -87,7 +88,7 @@ struct EvolutionOptions {
   Scheme scheme = Scheme::Upwind1;
   Hamiltonian hamiltonian = Hamiltonian::Godunov;
   int rk_order = 1;             // 1: forward Euler, 3: TVD-RK3
-  double cfl = 0.5;             // in (0, 1]
+  double cfl = 0.0;             // in (0, 1]; 0: 0.5 for forward Euler, 0.9 for TVD-RK3
   int steps = 0;                // run this many steps, or ...
   double time = 0;              // ... until this time (exactly one of the two > 0)
   int max_steps = 1000000;      // cap for time-driven runs
@@ -103,6 +104,11 @@ enum class StopReason { Completed, Cancelled, NonFinite };
 
 struct EvolutionSeconds {
   double operator_eval = 0;     // derivatives, curvature, speed, per-voxel rates (all stages)
+  // The operator's phases in CPU seconds summed over threads (wall time with 1 thread):
+  double gradient_cpu = 0;      // tiles, upwind and central derivatives, edge stencils
+  double curvature_cpu = 0;     // H, or H, K, k1, k2
+  double speed_cpu = 0;         // the speed function
+  double rates_cpu = 0;         // Hamiltonians and rates
   double update = 0;            // RK combinations, checks
   double tracking = 0;          // band upkeep
   double redistance = 0;

@@ -86,7 +86,7 @@ struct EvolveArgs {
   std::string scheme = "godunov";  // godunov | eno2 | weno5
   std::string hamiltonian = "godunov";  // godunov | llf
   int rk = 1;
-  double cfl = 0.5;
+  double cfl = 0.0;                // 0: 0.5 for --rk 1, 0.9 for --rk 3
   int redistance_every = 0;
   double drift_tolerance = 0.0;
   bool extension = false;

@@ -72,6 +72,10 @@ int run_evolve(const EvolveArgs& args) {
   stats.seconds["read"] = secs(t0, t1);
   stats.seconds["evolve"] = secs(t1, t2);
   stats.seconds["operator"] = result.seconds.operator_eval;
+  stats.seconds["gradient_cpu"] = result.seconds.gradient_cpu;
+  stats.seconds["curvature_cpu"] = result.seconds.curvature_cpu;
+  stats.seconds["speed_cpu"] = result.seconds.speed_cpu;
+  stats.seconds["rates_cpu"] = result.seconds.rates_cpu;
   stats.seconds["update"] = result.seconds.update;
   stats.seconds["tracking"] = result.seconds.tracking;
   stats.seconds["redistance"] = result.seconds.redistance;
