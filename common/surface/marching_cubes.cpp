@@ -42,15 +42,9 @@ struct Scratch {
 void process_brick(const NarrowBand& band, std::uint32_t b, double iso, Scratch& scratch,
                    BrickOut& out) {
   CellTile& t = scratch.tile;
-  gather_cell_tile(band, b, t);
-  out.around = t.around;
-  const Coord base = brick_origin(band.bricks()[b].coord);
   const double h = band.voxel_size();
-  const Vec3d corner = band.origin() + Vec3d{double(base.x), double(base.y), double(base.z)} * h;
   ValidCells valid;
-  valid.compute(t, iso);
-  out.vertices.reserve(valid.mixed_cells + 8);
-  out.normals.reserve(valid.mixed_cells + 8);
+  const Vec3d corner = begin_brick(band, b, iso, t, valid, out);
   out.triangles.reserve(2 * valid.mixed_cells + 8);
 
   // Edge crossings of the cells [0, 8)^3, and the vertices of the owned ones in slot order.

@@ -245,6 +245,20 @@ inline int best_fan_start(const Vec3d* p, int n) {
 
 void check_iso(const NarrowBand& band, double iso, std::string_view where);
 
+// The start both extractors share for one brick: gathers its tile, records the neighbourhood
+// the output's vertex keys refer to, classifies the tile's rows, reserves the vertex buffers;
+// returns the world position of the brick's voxel (0, 0, 0).
+template <typename Out>
+Vec3d begin_brick(const NarrowBand& band, std::uint32_t b, double iso, CellTile& t, ValidCells& valid, Out& out) {
+  gather_cell_tile(band, b, t);
+  out.around = t.around;
+  valid.compute(t, iso);
+  out.vertices.reserve(std::size_t(valid.mixed_cells) + 8);
+  out.normals.reserve(std::size_t(valid.mixed_cells) + 8);
+  const Coord base = brick_origin(band.bricks()[b].coord);
+  return band.origin() + Vec3d{double(base.x), double(base.y), double(base.z)} * band.voxel_size();
+}
+
 // Which bricks can own output at iso: a brick owns the cells and grid edges whose lowest voxel
 // lies in it, so it has work only when the active values of itself and its 7 upper neighbours
 // (+x, +y, +z and their combinations) lie on both sides of iso. One pass over the values.

@@ -195,15 +195,10 @@ struct Scratch {
 void process_brick(const NarrowBand& band, std::uint32_t b, double iso, int iterations,
                    Scratch& s, BrickOut& out) {
   CellTile& t = s.tile;
-  gather_cell_tile(band, b, t);
-  out.around = t.around;
-  const Coord base = brick_origin(band.bricks()[b].coord);
   const double h = band.voxel_size();
-  const Vec3d corner = band.origin() + Vec3d{double(base.x), double(base.y), double(base.z)} * h;
   ValidCells valid;
-  valid.compute(t, iso);
-  out.vertices.reserve(valid.mixed_cells + 8);
-  out.normals.reserve(valid.mixed_cells + 8);
+  const Vec3d corner = begin_brick(band, b, iso, t, valid, out);
+  const Coord base = brick_origin(band.bricks()[b].coord);
   out.quads.reserve(valid.mixed_cells + 8);
   s.edges.compute(t, valid, iso, 0);
   s.field.compute(t, valid, iso);
