@@ -556,19 +556,6 @@ std::string first_non_finite(const NarrowBand& band, const std::vector<float>& v
 
 }  // namespace
 
-OperatorResult evaluate_operator(const NarrowBand& band, const EvolutionOptions& options, double time) {
-  OperatorSetup setup{options};
-  setup.time = time;
-  if (has_speed(options) && (options.speed.needs & kNeedsMeanAverage)) setup.kavg = mean_curvature_average(band);
-  OperatorOutput out = run_operator(band, setup);
-  OperatorResult r;
-  r.rate = std::move(out.rate);
-  r.max_hyperbolic = out.max_hyperbolic;
-  r.max_speed = out.max_speed;
-  r.grad_drift = out.drift_count ? out.drift_sum / double(out.drift_count) : 0.0;
-  return r;
-}
-
 EvolutionResult evolve(const NarrowBand& band, const EvolutionOptions& options) {
   check_options(band, options);
   const auto start = Clock::now();

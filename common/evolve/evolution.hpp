@@ -131,14 +131,4 @@ struct EvolutionResult {
 
 EvolutionResult evolve(const NarrowBand& band, const EvolutionOptions& options);
 
-// One evaluation of the spatial operator: du/dt for every active voxel (band value order),
-// and the largest hyperbolic rate and parabolic coefficient seen. For tests and benchmarks.
-struct OperatorResult {
-  std::vector<float> rate;
-  double max_hyperbolic = 0;    // sqrt(3) |beta_a| + |V|_1
-  double max_speed = 0;
-  double grad_drift = 0;
-};
-OperatorResult evaluate_operator(const NarrowBand& band, const EvolutionOptions& options, double time);
-
 }  // namespace levelset::evolve
