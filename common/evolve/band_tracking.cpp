@@ -52,20 +52,31 @@ TrackResult track_band(const NarrowBand& moved, const TrackOptions& options) {
     }
     return local_index(q.x, q.y, q.z);
   };
+  // Edge voxels by mask arithmetic: active voxels with an inactive 6-neighbour (a missing
+  // brick counts as inactive). Layout (brick_mask.hpp): word = z-slice, byte = y-row, bit = x.
   std::vector<BrickMask> edge(n);
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 32), [&](const tbb::blocked_range<std::size_t>& r) {
-    for (std::size_t b = r.begin(); b != r.end(); ++b)
-      old_active[b].for_each_set([&](int i) {
-        const Coord l = local_coord(i);
-        for (int f = 0; f < 6; ++f) {
-          std::size_t nb;
-          const int j = neighbor(b, l, f, nb);
-          if (j < 0 || !old_active[nb].test(j)) {
-            edge[b].set(i);
-            return;
-          }
-        }
-      });
+    constexpr std::uint64_t kCol0 = 0x0101010101010101ull, kCol7 = 0x8080808080808080ull;
+    const BrickMask none{};
+    for (std::size_t b = r.begin(); b != r.end(); ++b) {
+      const BrickMask& m = old_active[b];
+      auto face = [&](int f) -> const BrickMask& {
+        const std::uint32_t o = w.nbr[b][std::size_t(f)];
+        return o == kNoBrick ? none : old_active[o];
+      };
+      const BrickMask &xm = face(0), &xp = face(1), &ym = face(2), &yp = face(3), &zm = face(4), &zp = face(5);
+      for (int z = 0; z < 8; ++z) {
+        const std::uint64_t a = m.words[std::size_t(z)];
+        // Active neighbour in each direction, per voxel.
+        const std::uint64_t left = (a << 1 & ~kCol0) | (xm.words[std::size_t(z)] & kCol7) >> 7;
+        const std::uint64_t right = (a >> 1 & ~kCol7) | (xp.words[std::size_t(z)] & kCol0) << 7;
+        const std::uint64_t down = a << 8 | ym.words[std::size_t(z)] >> 56;
+        const std::uint64_t up = a >> 8 | yp.words[std::size_t(z)] << 56;
+        const std::uint64_t below = z > 0 ? m.words[std::size_t(z - 1)] : zm.words[7];
+        const std::uint64_t above = z < 7 ? m.words[std::size_t(z + 1)] : zp.words[0];
+        edge[b].words[std::size_t(z)] = a & ~(left & right & down & up & below & above);
+      }
+    }
   });
   // Signed value (voxels) of a previously active voxel: the polynomial runs across the zero
   // level, where u is smooth.
@@ -109,6 +120,7 @@ TrackResult track_band(const NarrowBand& moved, const TrackOptions& options) {
     return std::clamp(std::abs(best), lo, std::max(lo, hi));
   };
   std::vector<std::vector<std::pair<int, float>>> edge_values(n);
+  if (options.extrapolate_edge)
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 32), [&](const tbb::blocked_range<std::size_t>& r) {
     for (std::size_t b = r.begin(); b != r.end(); ++b)
       edge[b].for_each_set([&](int i) {
@@ -130,8 +142,9 @@ TrackResult track_band(const NarrowBand& moved, const TrackOptions& options) {
     for (std::size_t b = r.begin(); b != r.end(); ++b) {
       float* d = w.values(std::uint32_t(b));
       std::uint64_t count = 0;
-      w.domain[b].for_each_set([&](int i) {
-        if (old_active[b].test(i)) return;
+      BrickMask fresh;
+      for (int z = 0; z < 8; ++z) fresh.words[std::size_t(z)] = w.domain[b].words[std::size_t(z)] & ~old_active[b].words[std::size_t(z)];
+      fresh.for_each_set([&](int i) {
         const Coord l = local_coord(i);
         float m[3] = {detail::kInf, detail::kInf, detail::kInf};
         for (int f = 0; f < 6; ++f) {
@@ -143,7 +156,8 @@ TrackResult track_band(const NarrowBand& moved, const TrackOptions& options) {
         // The high-order extrapolation where it agrees with that to half a voxel (smooth
         // field; stencils near the edge read it), the Godunov value where it does not.
         const float first_order = detail::godunov(m[0], m[1], m[2]);
-        const float high = extrapolate(b, i, false);
+        // Beyond W + 1/2 neither value activates the voxel: skip the extrapolation.
+        const float high = first_order <= float(w_half) + 0.5f ? extrapolate(b, i, false) : -1.0f;
         const float best = high >= 0.0f && std::abs(high - first_order) <= 0.5f ? high : first_order;
         d[i] = best;
         count += best <= float(w_half);

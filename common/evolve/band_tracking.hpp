@@ -27,6 +27,8 @@ namespace levelset::evolve {
 
 struct TrackOptions {
   double half_width = 3.0;  // voxels
+  // Re-extrapolate the edge layer (off when the caller keeps it fresh itself, as evolve does).
+  bool extrapolate_edge = true;
   ProgressHook progress;
 };
 

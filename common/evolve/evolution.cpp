@@ -532,6 +532,14 @@ void check_options(const NarrowBand& band, const EvolutionOptions& o) {
   if (!(o.track_distance > 0 && o.track_distance <= 1)) bad("track_distance must be in (0, 1] voxels");
 }
 
+// f(i) for i in [0, n), in parallel (the RK combinations and checks over all values).
+template <typename F>
+void for_each_value(std::size_t n, F&& f) {
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 1 << 14), [&](const tbb::blocked_range<std::size_t>& r) {
+    for (std::size_t i = r.begin(); i != r.end(); ++i) f(i);
+  });
+}
+
 // First non-finite value, as "voxel (x, y, z)"; empty when all are finite.
 std::string first_non_finite(const NarrowBand& band, const std::vector<float>& values) {
   std::atomic<std::size_t> at{std::numeric_limits<std::size_t>::max()};
@@ -614,37 +622,41 @@ EvolutionResult evolve(const NarrowBand& band, const EvolutionOptions& options) 
       auto t1 = Clock::now();
       const std::vector<float> u0(cur.values().begin(), cur.values().end());
       next.resize(u0.size());
-      for (std::size_t i = 0; i < u0.size(); ++i) next[i] = float(double(u0[i]) + dt * double(op.rate[i]));
+      for_each_value(u0.size(), [&](std::size_t i) { next[i] = float(double(u0[i]) + dt * double(op.rate[i])); });
       if (options.rk_order == 3) {
-        NarrowBand stage = cur;
+        // Stages are evaluated on `cur` with its values swapped out and back (no band copy).
         OperatorSetup s2 = setup;
         s2.want_edges = false;
         s2.want_betas = false;
-        std::vector<float> u1 = next;
-        stage.swap_values(u1);
+        cur.swap_values(next);  // cur holds u1, next holds u0
         s2.time = t + dt;
         auto t2 = Clock::now();
-        OperatorOutput o1 = run_operator(stage, s2);
+        OperatorOutput o1 = run_operator(cur, s2);
+        cur.swap_values(next);  // back: next holds u1
         add_phases(o1);
         std::vector<float> r1 = std::move(o1.rate);
         result.seconds.operator_eval += since(t2);
         std::vector<float> u2(u0.size());
-        for (std::size_t i = 0; i < u0.size(); ++i)
+        for_each_value(u0.size(), [&](std::size_t i) {
           u2[i] = float(0.75 * u0[i] + 0.25 * (double(next[i]) + dt * double(r1[i])));
-        std::vector<float> tmp = u2;
-        stage.swap_values(tmp);
+        });
+        cur.swap_values(u2);  // cur holds u2
         s2.time = t + 0.5 * dt;
         t2 = Clock::now();
-        OperatorOutput o2 = run_operator(stage, s2);
+        OperatorOutput o2 = run_operator(cur, s2);
+        cur.swap_values(u2);  // back
         add_phases(o2);
         std::vector<float> r2 = std::move(o2.rate);
         result.seconds.operator_eval += since(t2);
-        for (std::size_t i = 0; i < u0.size(); ++i)
+        for_each_value(u0.size(), [&](std::size_t i) {
           next[i] = float(u0[i] / 3.0 + 2.0 / 3.0 * (double(u2[i]) + dt * double(r2[i])));
+        });
       }
-      mine = false;
-      for (std::size_t i = 0; i < u0.size() && !mine; ++i)
-        mine = op.edge[i] && ((u0[i] < 0.0f) != (next[i] < 0.0f));
+      std::atomic<bool> fired{false};
+      for_each_value(u0.size(), [&](std::size_t i) {
+        if (op.edge[i] && ((u0[i] < 0.0f) != (next[i] < 0.0f))) fired.store(true, std::memory_order_relaxed);
+      });
+      mine = fired.load();
       result.seconds.update += since(t1);
       if (!mine || attempt == 4) break;
       ++result.landmine_count;
@@ -661,24 +673,29 @@ EvolutionResult evolve(const NarrowBand& band, const EvolutionOptions& options) 
     }
     auto t3 = Clock::now();
     // The edge layer from the new interior values (EdgeStencil), on its own side only.
-    std::vector<std::pair<std::uint32_t, float>> edge_values;
-    for (const std::vector<EdgeStencil>& list : op.edge_stencils)
-      for (const EdgeStencil& e : list) {
-        double v = 0;
-        for (int k = 0; k < e.count; ++k) v += double(e.coef[std::size_t(k)]) * double(next[e.source[std::size_t(k)]]);
-        const bool inside = cur.values()[e.target] < 0.0f;
-        if (inside != (v < 0.0)) continue;
-        double lo = 0.0, hi = std::numeric_limits<double>::infinity();
-        for (int k = 0; k < e.neighbors; ++k) {
-          const double un = next[e.neighbor[std::size_t(k)]];
-          if ((un < 0.0) != inside) continue;
-          lo = std::max(lo, std::abs(un) - h);
-          hi = std::min(hi, std::abs(un) + h);
+    std::vector<std::vector<std::pair<std::uint32_t, float>>> edge_values(op.edge_stencils.size());
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, op.edge_stencils.size(), 64), [&](const tbb::blocked_range<std::size_t>& r) {
+      for (std::size_t b = r.begin(); b != r.end(); ++b)
+        for (const EdgeStencil& e : op.edge_stencils[b]) {
+          double v = 0;
+          for (int k = 0; k < e.count; ++k) v += double(e.coef[std::size_t(k)]) * double(next[e.source[std::size_t(k)]]);
+          const bool inside = cur.values()[e.target] < 0.0f;
+          if (inside != (v < 0.0)) continue;
+          double lo = 0.0, hi = std::numeric_limits<double>::infinity();
+          for (int k = 0; k < e.neighbors; ++k) {
+            const double un = next[e.neighbor[std::size_t(k)]];
+            if ((un < 0.0) != inside) continue;
+            lo = std::max(lo, std::abs(un) - h);
+            hi = std::min(hi, std::abs(un) + h);
+          }
+          const double mag = std::clamp(std::abs(v), lo, std::max(lo, hi));
+          edge_values[b].push_back({e.target, float(inside ? -mag : mag)});
         }
-        const double mag = std::clamp(std::abs(v), lo, std::max(lo, hi));
-        edge_values.push_back({e.target, float(inside ? -mag : mag)});
-      }
-    for (const auto& [i, v] : edge_values) next[i] = v;
+    });
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, edge_values.size(), 64), [&](const tbb::blocked_range<std::size_t>& r) {
+      for (std::size_t b = r.begin(); b != r.end(); ++b)
+        for (const auto& [i, v] : edge_values[b]) next[i] = v;
+    });
     // Band upkeep once the front may have moved track_distance voxels since the last one.
     motion += op.max_front_speed * dt;
     cur.swap_values(next);
@@ -686,6 +703,7 @@ EvolutionResult evolve(const NarrowBand& band, const EvolutionOptions& options) 
     if (mine || motion >= options.track_distance * h) {
       TrackOptions track;
       track.half_width = half_width;
+      track.extrapolate_edge = false;  // done above, every step
       tracked = track_band(cur, track);
       result.activated += tracked.activated;
       result.retired += tracked.retired;
