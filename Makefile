@@ -4,7 +4,7 @@ BUILD  := build/$(PRESET)
 OUT    ?= out
 JOBS   ?= $(shell nproc)
 
-.PHONY: all deps configure build run test bench clean
+.PHONY: all deps configure build run test bench fuzz clean
 
 all: build
 
@@ -30,6 +30,12 @@ test: build
 # Benchmarks against OpenVDB (not part of the test suite; prints measured ratios).
 bench: build
 	@cmake --build $(BUILD) --target bench -j $(JOBS)
+
+# libFuzzer run (clang, ASan + UBSan) of one fuzz target in build/fuzz; fails on any finding.
+FUZZ_TARGET  ?= fuzz_formula
+FUZZ_SECONDS ?= 60
+fuzz: deps
+	@bash tests/fuzz/run_libfuzzer.sh $(FUZZ_TARGET) $(FUZZ_SECONDS)
 
 clean:
 	rm -rf build $(OUT)

@@ -7,6 +7,8 @@ set -euo pipefail
 PACKAGES=(
   # toolchain
   build-essential cmake ninja-build ccache pkg-config git
+  # libFuzzer runs (make fuzz): clang with its fuzzer/sanitizer runtimes
+  clang-14 libclang-rt-14-dev
   # core library
   libtbb-dev libzstd-dev libxxhash-dev
   # command line

@@ -100,8 +100,10 @@ int main(int argc, char** argv) {
   CLI::App* evolve_cmd = app.add_subcommand("evolve", "Move the surface with a speed function (level set equation)");
   evolve_cmd->add_option("input", evolve.input, "Input .lsg")->required();
   evolve_cmd->add_option("-o,--output", evolve.output, "Output .lsg file")->required();
-  evolve_cmd->add_option("--speed", evolve.speed, "Built-in speed")
-      ->check(CLI::IsMember(levelset::evolve::builtin_speed_names()));
+  std::string speed_help = "Speed: a formula (e.g. '1-eps*H', see the README) or a built-in name:";
+  for (const std::string& n : levelset::evolve::builtin_speed_names()) speed_help += " " + n;
+  evolve_cmd->add_option("--speed", evolve.speed, speed_help);
+  evolve_cmd->add_option("--const", evolve.constants, "Named constant for the formula, NAME=VALUE (repeatable)");
   evolve_cmd->add_option("--c", evolve.c, "Speed constant (constant, one-minus-eps-kappa)");
   evolve_cmd->add_option("--eps", evolve.eps, "Curvature weight (one-minus-eps-kappa)");
   evolve_cmd->add_option("--velocity", evolve.velocity, "Constant advection velocity x,y,z (world units per time)")

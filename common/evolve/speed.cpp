@@ -1,8 +1,11 @@
 #include "evolve/speed.hpp"
 
+#include <array>
 #include <cmath>
+#include <memory>
 
 #include "core/error.hpp"
+#include "formula/formula.hpp"
 
 namespace levelset::evolve {
 
@@ -15,72 +18,128 @@ void require_finite(double v, std::string_view what) {
 
 }  // namespace
 
+namespace {
+
+using formula::Var;
+
+std::uint32_t needs_of(const formula::Program& p) {
+  std::uint32_t needs = kNeedsNothing;
+  if (p.uses_var(Var::x) || p.uses_var(Var::y) || p.uses_var(Var::z)) needs |= kNeedsPosition;
+  if (p.uses_var(Var::nx) || p.uses_var(Var::ny) || p.uses_var(Var::nz)) needs |= kNeedsNormal;
+  if (p.uses_var(Var::H)) needs |= kNeedsMean;
+  if (p.uses_var(Var::K) || p.uses_var(Var::k1) || p.uses_var(Var::k2)) needs |= kNeedsPrincipal;
+  if (p.uses_var(Var::kavg)) needs |= kNeedsMeanAverage | kNeedsMean;
+  if (p.uses_var(Var::grad)) needs |= kNeedsGradNorm;
+  return needs;
+}
+
+// The batch's arrays by formula variable.
+std::array<const float*, formula::kVarCount> inputs_of(const SpeedBatch& b, std::vector<float>& scalars) {
+  std::array<const float*, formula::kVarCount> in{};
+  in[int(Var::d)] = b.d;
+  in[int(Var::x)] = b.x;
+  in[int(Var::y)] = b.y;
+  in[int(Var::z)] = b.z;
+  in[int(Var::nx)] = b.nx;
+  in[int(Var::ny)] = b.ny;
+  in[int(Var::nz)] = b.nz;
+  in[int(Var::H)] = b.mean;
+  in[int(Var::K)] = b.gauss;
+  in[int(Var::k1)] = b.k1;
+  in[int(Var::k2)] = b.k2;
+  in[int(Var::grad)] = b.grad;
+  // Per-batch scalars broadcast: t, h, kavg.
+  scalars.assign(std::size_t(3) * std::size_t(b.count), 0.0f);
+  std::fill_n(scalars.begin(), b.count, float(b.time));
+  std::fill_n(scalars.begin() + b.count, b.count, float(b.h));
+  std::fill_n(scalars.begin() + 2 * b.count, b.count, float(b.kavg));
+  in[int(Var::t)] = scalars.data();
+  in[int(Var::h)] = scalars.data() + b.count;
+  in[int(Var::kavg)] = scalars.data() + 2 * b.count;
+  return in;
+}
+
+// Largest |f| over curvature probes of size <= 1 (the other inputs at neutral values).
+double probe_diffusion(const formula::Program& p) {
+  double worst = 0.0;
+  for (double H : {-1.0, 0.0, 1.0})
+    for (double K : {-1.0, 0.0, 0.25, 1.0}) {
+      std::array<double, formula::kVarCount> v{};
+      v[int(Var::grad)] = 1.0;
+      v[int(Var::nz)] = 1.0;
+      v[int(Var::h)] = 1.0;
+      v[int(Var::H)] = H;
+      v[int(Var::K)] = K;
+      v[int(Var::k1)] = 0.5 * H;
+      v[int(Var::k2)] = 0.5 * H;
+      const double f = p.evaluate_scalar(v);
+      if (std::isfinite(f)) worst = std::max(worst, std::abs(f));
+    }
+  return std::max(worst, 0.05);
+}
+
+}  // namespace
+
+SpeedFunction formula_speed(std::string_view text, const std::map<std::string, double, std::less<>>& constants) {
+  formula::CompileOptions options;
+  options.constants = constants;
+  formula::SplitProgram split = formula::compile_split_by_curvature(text, options);
+  for (const formula::Program* p : {&split.without_curvature, &split.with_curvature})
+    for (Var f : {Var::dist, Var::dgx, Var::dgy, Var::dgz, Var::dn, Var::img, Var::edge, Var::roi})
+      if (p->uses_var(f))
+        throw Error(ErrorCode::InvalidArgument, "speed",
+                    std::string("the field '") + formula::var_name(f) + "' is not available here (it needs a session that carries it)");
+  SpeedFunction s;
+  s.name = std::string(text);
+  s.needs = needs_of(split.without_curvature) | needs_of(split.with_curvature);
+  const formula::Program& adv = split.without_curvature;
+  const formula::Program& par = split.with_curvature;
+  s.has_advective = !(adv.is_constant() && adv.constant_value() == 0.0);
+  s.has_parabolic = !(par.is_constant() && par.constant_value() == 0.0);
+  s.diffusion = s.has_parabolic ? probe_diffusion(par) : 0.0;
+  auto programs = std::make_shared<formula::SplitProgram>(std::move(split));
+  s.eval = [programs](const SpeedBatch& b, const SpeedOutput& out) {
+    thread_local formula::Workspace ws;
+    thread_local std::vector<float> scalars;
+    const auto in = inputs_of(b, scalars);
+    programs->without_curvature.evaluate(in, b.count, out.advective, ws);
+    programs->with_curvature.evaluate(in, b.count, out.parabolic, ws);
+  };
+  return s;
+}
+
 SpeedFunction constant_speed(double c) {
   require_finite(c, "the constant speed");
-  SpeedFunction s;
+  SpeedFunction s = formula_speed("c", {{"c", c}});
   s.name = "constant";
-  s.eval = [c](const SpeedBatch& b, const SpeedOutput& out) {
-    for (int i = 0; i < b.count; ++i) out.advective[i] = float(c);
-  };
   return s;
 }
 
 SpeedFunction mean_curvature_flow() {
-  SpeedFunction s;
+  SpeedFunction s = formula_speed("-H");
   s.name = "mean-curvature";
-  s.needs = kNeedsMean;
-  s.has_advective = false;
-  s.has_parabolic = true;
-  s.diffusion = 1.0;
-  s.eval = [](const SpeedBatch& b, const SpeedOutput& out) {
-    for (int i = 0; i < b.count; ++i) out.parabolic[i] = -b.mean[i];
-  };
   return s;
 }
 
 SpeedFunction mean_gaussian_flow() {
-  SpeedFunction s;
+  SpeedFunction s = formula_speed("-sign(H)*sqrt(max(K,0))");
   s.name = "mean-gaussian";
-  s.needs = kNeedsPrincipal;
-  s.has_advective = false;
-  s.has_parabolic = true;
-  s.diffusion = 0.5;  // sqrt(K) <= |H| / 2
-  s.eval = [](const SpeedBatch& b, const SpeedOutput& out) {
-    for (int i = 0; i < b.count; ++i) {
-      const float k = b.gauss[i] > 0.0f ? std::sqrt(b.gauss[i]) : 0.0f;
-      out.parabolic[i] = b.mean[i] > 0.0f ? -k : (b.mean[i] < 0.0f ? k : 0.0f);
-    }
-  };
+  s.diffusion = 0.5;  // sqrt(K) <= |H| / 2 for real surfaces (the probe is more cautious)
   return s;
 }
 
 SpeedFunction volume_preserving_flow() {
-  SpeedFunction s;
+  SpeedFunction s = formula_speed("-(H-kavg)");
   s.name = "volume-preserving";
-  s.needs = kNeedsMean | kNeedsMeanAverage;
-  s.has_advective = false;
-  s.has_parabolic = true;
   s.diffusion = 1.0;
-  s.eval = [](const SpeedBatch& b, const SpeedOutput& out) {
-    for (int i = 0; i < b.count; ++i) out.parabolic[i] = -(b.mean[i] - float(b.kavg));
-  };
   return s;
 }
 
 SpeedFunction curvature_regularized(double c, double eps) {
   require_finite(c, "c");
   require_finite(eps, "eps");
-  SpeedFunction s;
+  SpeedFunction s = formula_speed("c - c*eps*H", {{"c", c}, {"eps", eps}});  // c advective, the rest parabolic
   s.name = "one-minus-eps-kappa";
-  s.needs = kNeedsMean;
-  s.has_parabolic = true;
-  s.diffusion = std::abs(c * eps);
-  s.eval = [c, eps](const SpeedBatch& b, const SpeedOutput& out) {
-    for (int i = 0; i < b.count; ++i) {
-      out.advective[i] = float(c);
-      out.parabolic[i] = float(-c * eps * double(b.mean[i]));
-    }
-  };
   return s;
 }
 

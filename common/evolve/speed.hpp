@@ -17,6 +17,7 @@
 
 #include <cstdint>
 #include <functional>
+#include <map>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -64,12 +65,20 @@ struct SpeedFunction {
   std::function<void(const SpeedBatch&, const SpeedOutput&)> eval;
 };
 
-// Built-in speeds (thesis chapter 3):
-SpeedFunction constant_speed(double c);                  // offset: beta = c
-SpeedFunction mean_curvature_flow();                     // beta = -H
-SpeedFunction mean_gaussian_flow();                      // beta = -sign(H) sqrt(max(K, 0)) (eq. 3.4/5.2)
-SpeedFunction volume_preserving_flow();                  // beta = -(H - kavg) (eq. 3.5)
-SpeedFunction curvature_regularized(double c, double eps);  // beta = c (1 - eps H) (eq. 3.6 with c = 1)
+// A typed speed formula (formula/formula.hpp) with named constants: its top-level terms that
+// read curvatures (H K k1 k2 kavg) form the parabolic part, the others the advective part.
+// Only the inputs the formula reads are computed. The fields of a session (dist dgx dgy dgz
+// dn img edge roi) are not available to evolve yet: Error{InvalidArgument} naming the field.
+// The diffusion bound is probed from the parabolic part (largest |beta_p| over curvatures of
+// size <= 1 / world unit, at least 0.05). Errors: those of formula::compile.
+SpeedFunction formula_speed(std::string_view formula, const std::map<std::string, double, std::less<>>& constants = {});
+
+// Built-in speeds (thesis chapter 3), defined as formulas:
+SpeedFunction constant_speed(double c);                  // "c": offset
+SpeedFunction mean_curvature_flow();                     // "-H"
+SpeedFunction mean_gaussian_flow();                      // "-sign(H)*sqrt(max(K,0))" (eq. 3.4/5.2)
+SpeedFunction volume_preserving_flow();                  // "-(H-kavg)" (eq. 3.5)
+SpeedFunction curvature_regularized(double c, double eps);  // "c - c*eps*H" (eq. 3.6 with c = 1)
 
 // The built-ins by name: "constant" (c), "mean-curvature", "mean-gaussian",
 // "volume-preserving", "one-minus-eps-kappa" (c, eps). Error{InvalidArgument} naming the

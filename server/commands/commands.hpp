@@ -77,7 +77,8 @@ SurfaceResult extract_surface(const NarrowBand& band, const std::string& method,
 struct EvolveArgs {
   std::string input;
   std::string output;
-  std::string speed;               // a built-in speed name
+  std::string speed;               // a built-in speed name or a formula
+  std::vector<std::string> constants;  // NAME=VALUE for the formula
   double c = 1.0;                  // speed parameters (constant / one-minus-eps-kappa)
   double eps = 0.1;
   std::vector<double> velocity;    // x,y,z: constant advection velocity (world units per time)

@@ -1,6 +1,9 @@
 // levelsetd evolve IN.lsg -o OUT.lsg --speed NAME (--steps N | --time T) [...]: move the
 // surface with the level set equation (common/evolve/evolution.hpp).
+#include <algorithm>
 #include <chrono>
+#include <cstdlib>
+#include <map>
 #include <cstdio>
 
 #include "commands/commands.hpp"
@@ -35,7 +38,24 @@ int run_evolve(const EvolveArgs& args) {
   const LsgReadResult in = load_lsg(args.input);
   const auto t1 = std::chrono::steady_clock::now();
   evolve::EvolutionOptions options;
-  if (!args.speed.empty()) options.speed = evolve::builtin_speed(args.speed, args.c, args.eps);
+  if (!args.speed.empty()) {
+    const auto names = evolve::builtin_speed_names();
+    if (std::find(names.begin(), names.end(), args.speed) != names.end()) {
+      options.speed = evolve::builtin_speed(args.speed, args.c, args.eps);
+    } else {
+      std::map<std::string, double, std::less<>> constants;
+      for (const std::string& kv : args.constants) {
+        const std::size_t eq = kv.find('=');
+        char* end = nullptr;
+        const std::string value = eq == std::string::npos ? "" : kv.substr(eq + 1);
+        const double v = std::strtod(value.c_str(), &end);
+        if (eq == std::string::npos || eq == 0 || value.empty() || end != value.c_str() + value.size())
+          throw Error(ErrorCode::InvalidArgument, "--const", "expected NAME=VALUE, got '" + kv + "'");
+        constants[kv.substr(0, eq)] = v;
+      }
+      options.speed = evolve::formula_speed(args.speed, constants);
+    }
+  }
   if (!args.velocity.empty()) {
     options.velocity.kind = evolve::Velocity::Kind::Constant;
     options.velocity.constant = {args.velocity[0], args.velocity[1], args.velocity[2]};

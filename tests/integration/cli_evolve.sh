@@ -41,10 +41,21 @@ $py -c "import sys, math; r=$r; e=math.sqrt(1 - 4*0.05); sys.exit(0 if abs(r/e -
   || fail "mean curvature flow radius $r, expected $($py -c 'import math; print(math.sqrt(0.8))')"
 pass
 
-# Errors: usage (exit 2) and typed errors (exit 1), one line each.
+# A typed formula gives the same result as the built-in it spells out.
+"$bin" evolve "$dir/sphere.lsg" -o "$dir/f1.lsg" --speed '1 - eps*H' --const eps=0.1 --steps 5 > /dev/null || fail "formula"
+"$bin" evolve "$dir/sphere.lsg" -o "$dir/f2.lsg" --speed one-minus-eps-kappa --eps 0.1 --steps 5 > /dev/null || fail "built-in"
+[ "$(radius "$dir/f1.lsg")" = "$(radius "$dir/f2.lsg")" ] || fail "formula and built-in differ"
+pass
+
+# Errors: usage (exit 2) and typed errors (exit 1).
 set +e
 "$bin" evolve "$dir/sphere.lsg" -o "$dir/x.lsg" --speed warp --steps 3 2> "$dir/err1.txt"; code=$?
-[ $code -eq 2 ] || fail "unknown speed exit $code"; pass
+[ $code -eq 1 ] && grep -q "unknown name 'warp'" "$dir/err1.txt" && grep -q '^  \^' "$dir/err1.txt" \
+  || fail "unknown speed name: exit $code, $(cat "$dir/err1.txt")"; pass
+"$bin" evolve "$dir/sphere.lsg" -o "$dir/x.lsg" --speed '1 - eps*' --const eps=0.1 --steps 3 2> "$dir/err1b.txt"; code=$?
+[ $code -eq 1 ] && grep -q "column 9" "$dir/err1b.txt" || fail "formula syntax error: exit $code"; pass
+"$bin" evolve "$dir/sphere.lsg" -o "$dir/x.lsg" --speed '1 - eps*H' --const eps --steps 3 2> "$dir/err1c.txt"; code=$?
+[ $code -eq 1 ] && grep -q "NAME=VALUE" "$dir/err1c.txt" || fail "bad --const: exit $code"; pass
 "$bin" evolve "$dir/sphere.lsg" -o "$dir/x.lsg" --speed constant 2> "$dir/err2.txt"; code=$?
 [ $code -eq 2 ] && grep -q -- "--steps N or --time T" "$dir/err2.txt" || fail "missing steps/time exit $code"; pass
 "$bin" evolve "$dir/sphere.lsg" -o "$dir/x.lsg" --speed constant --steps 2 --time 1 2> "$dir/err3.txt"; code=$?

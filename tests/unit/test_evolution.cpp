@@ -5,6 +5,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <functional>
 #include <memory>
 #include <numbers>
 
@@ -306,6 +307,65 @@ TEST(Evolution, ExtensionVelocitiesKeepTheDistanceProperty) {
   }
   std::printf("mean ||grad u| - 1| near the surface: %.4f without, %.4f with extension velocities\n", drift[0], drift[1]);
   EXPECT_LT(drift[1], 0.5 * drift[0]);
+}
+
+// The built-ins are formulas now; hand-written C++ speeds must give the same evolution (the
+// thesis's formulas: mean-Gaussian eq. 5.2, 1 - eps kappa eq. 3.6, and a position-dependent
+// one standing in for the reconstruction's dn + dist H, whose fields need a session).
+TEST(Evolution, FormulasEvolveLikeHandWrittenSpeeds) {
+  const auto shape = make_builtin_shape("torus");
+  const NarrowBand band = band_of([&](const Vec3d& p) { return shape->distance(p); }, shape->bounds(), 40);
+  struct Case {
+    const char* formula;
+    std::function<void(const SpeedBatch&, const SpeedOutput&)> by_hand;
+    std::uint32_t needs;
+    bool advective, parabolic;
+    double diffusion;
+  };
+  const Case cases[] = {
+      {"-sign(H)*sqrt(max(K,0))",
+       [](const SpeedBatch& b, const SpeedOutput& o) {
+         for (int i = 0; i < b.count; ++i)
+           o.parabolic[i] = -(b.mean[i] > 0 ? 1.0f : (b.mean[i] < 0 ? -1.0f : 0.0f)) * std::sqrt(std::max(b.gauss[i], 0.0f));
+       },
+       kNeedsMean | kNeedsPrincipal, false, true, 0.5},
+      {"1-eps*H",
+       [](const SpeedBatch& b, const SpeedOutput& o) {
+         for (int i = 0; i < b.count; ++i) {
+           o.advective[i] = 1.0f;
+           o.parabolic[i] = -0.1f * b.mean[i];
+         }
+       },
+       kNeedsMean, true, true, 0.1},
+      {"0.3*x + 0.5*H",
+       [](const SpeedBatch& b, const SpeedOutput& o) {
+         for (int i = 0; i < b.count; ++i) {
+           o.advective[i] = 0.3f * b.x[i];
+           o.parabolic[i] = 0.5f * b.mean[i];
+         }
+       },
+       kNeedsMean | kNeedsPosition, true, true, 0.5}};
+  for (const Case& c : cases) {
+    const SpeedFunction f = formula_speed(c.formula, {{"eps", 0.1}});
+    EXPECT_EQ(f.needs, c.needs) << c.formula;
+    EXPECT_EQ(f.has_advective, c.advective) << c.formula;
+    EXPECT_EQ(f.has_parabolic, c.parabolic) << c.formula;
+    SpeedFunction hand = f;
+    hand.eval = c.by_hand;
+    hand.diffusion = f.diffusion;  // same time steps
+    EvolutionOptions o;
+    o.steps = 5;
+    o.speed = f;
+    const NarrowBand a = evolve(band, o).band;
+    o.speed = hand;
+    const NarrowBand b = evolve(band, o).band;
+    ASSERT_EQ(a.active_voxel_count(), b.active_voxel_count()) << c.formula;
+    double worst = 0;
+    for (std::size_t i = 0; i < a.values().size(); ++i)
+      worst = std::max(worst, double(std::abs(a.values()[i] - b.values()[i])));
+    std::printf("%-28s max |difference| %.3g\n", c.formula, worst);
+    EXPECT_LE(worst, 1e-6) << c.formula;
+  }
 }
 
 TEST(Evolution, RejectsBadOptions) {
