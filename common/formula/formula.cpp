@@ -54,7 +54,7 @@ struct Node {
 
 // ---- evaluation of one operation (double reference and float vectors share the rules) ----
 template <typename T>
-T apply(Op op, T a, T b, T c) {
+[[gnu::always_inline]] inline T apply(Op op, T a, T b, T c) {
   switch (op) {
     case Op::Neg: return -a;
     case Op::Not: return a == T(0) ? T(1) : T(0);
