@@ -3,6 +3,7 @@
 // Formula: the thesis's mean-Gaussian speed '-sign(H)*sqrt(K+abs(K))'. Inputs: random H, K
 // (fixed seed). Prints seconds for both, the ratio formula / C++ and the largest difference.
 // Usage: bench_formula [--quick]   (--quick: 10^5 samples, one run, for ctest)
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <random>
@@ -20,7 +21,7 @@ using levelset::bench::best_of;
 
 int main(int argc, char** argv) {
   const bool quick = bench::is_quick(argc, argv);
-  const std::size_t n = quick ? 100000 : 10240000;  // a multiple of 512
+  const std::size_t n = quick ? 100000 : 10240000;
   const int runs = quick ? 1 : 5;
   std::vector<float> H(n), K(n), a(n), b(n);
   std::mt19937 rng(3);
@@ -38,7 +39,7 @@ int main(int argc, char** argv) {
       for (std::size_t s = 0; s < n; s += formula::kMaxSamples) {
         in[int(formula::Var::H)] = H.data() + s;
         in[int(formula::Var::K)] = K.data() + s;
-        p.evaluate(in, formula::kMaxSamples, a.data() + s, ws);
+        p.evaluate(in, int(std::min<std::size_t>(formula::kMaxSamples, n - s)), a.data() + s, ws);
       }
     });
     const double t_cpp = best_of(runs, [&] {
