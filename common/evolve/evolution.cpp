@@ -41,6 +41,7 @@ struct Scratch {
   std::vector<float> tile = std::vector<float>(std::size_t(kDim) * kDim * kDim);
   std::vector<std::uint32_t> rows = std::vector<std::uint32_t>(std::size_t(kDim) * kDim);
   std::array<float, kBrickVoxels> d, x, y, z, nx, ny, nz, mean, gauss, k1, k2, grad, beta_a, beta_p;
+  std::array<float, kBrickVoxels> dist, dgx, dgy, dgz, dn, img, edge, roi;
   std::array<std::array<OneSided, 3>, kBrickVoxels> os;
   std::unique_ptr<struct AxisLines> lines;
   std::array<Vec3d, kBrickVoxels> vel;
@@ -258,11 +259,24 @@ void brick_operator(const NarrowBand& band, std::uint32_t b, const OperatorSetup
     const float* v = s.tile.data() + tile_index(l.x, l.y, l.z);
     s.d[std::size_t(k)] = *v;
     Vec3d world{};
-    if ((needs & kNeedsPosition) || (velocity && o.velocity.kind == Velocity::Kind::Field)) {
+    constexpr std::uint32_t kFieldNeeds = kNeedsDist | kNeedsDistGradient | kNeedsImage | kNeedsEdge | kNeedsRoi;
+    if ((needs & (kNeedsPosition | kFieldNeeds)) || (velocity && o.velocity.kind == Velocity::Kind::Field)) {
       world = band.world(origin + l);
       s.x[std::size_t(k)] = float(world.x);
       s.y[std::size_t(k)] = float(world.y);
       s.z[std::size_t(k)] = float(world.z);
+      const SpeedFields& f = o.fields;
+      const std::size_t u = std::size_t(k);
+      if (needs & kNeedsDist) s.dist[u] = float(f.dist(world));
+      if (needs & kNeedsDistGradient) {
+        const Vec3d g = f.dist_gradient(world);
+        s.dgx[u] = float(g.x);
+        s.dgy[u] = float(g.y);
+        s.dgz[u] = float(g.z);
+      }
+      if (needs & kNeedsImage) s.img[u] = float(f.image(world));
+      if (needs & kNeedsEdge) s.edge[u] = float(f.edge(world));
+      if (needs & kNeedsRoi) s.roi[u] = float(f.roi(world));
     }
     if (velocity)
       s.vel[std::size_t(k)] = o.velocity.kind == Velocity::Kind::Constant ? o.velocity.constant
@@ -299,6 +313,9 @@ void brick_operator(const NarrowBand& band, std::uint32_t b, const OperatorSetup
       s.nx[std::size_t(k)] = float(nrm.x);
       s.ny[std::size_t(k)] = float(nrm.y);
       s.nz[std::size_t(k)] = float(nrm.z);
+      if (needs & kNeedsDistGradient)
+        s.dn[std::size_t(k)] = float(double(s.dgx[std::size_t(k)]) * nrm.x + double(s.dgy[std::size_t(k)]) * nrm.y +
+                                     double(s.dgz[std::size_t(k)]) * nrm.z);
     }
     if (near) {
       drift_sum += std::abs(gn - 1.0);
@@ -361,6 +378,16 @@ void brick_operator(const NarrowBand& band, std::uint32_t b, const OperatorSetup
         batch.k2 = s.k2.data();
       }
       if (needs & kNeedsGradNorm) batch.grad = s.grad.data();
+      if (needs & kNeedsDist) batch.dist = s.dist.data();
+      if (needs & kNeedsDistGradient) {
+        batch.dgx = s.dgx.data();
+        batch.dgy = s.dgy.data();
+        batch.dgz = s.dgz.data();
+        if (needs & kNeedsNormal) batch.dn = s.dn.data();
+      }
+      if (needs & kNeedsImage) batch.img = s.img.data();
+      if (needs & kNeedsEdge) batch.edge = s.edge.data();
+      if (needs & kNeedsRoi) batch.roi = s.roi.data();
       speed.eval(batch, SpeedOutput{s.beta_a.data(), s.beta_p.data()});
     }
     if (setup.want_betas) {
@@ -529,6 +556,18 @@ void check_options(const NarrowBand& band, const EvolutionOptions& o) {
   if (o.redistance_every < 0 || !(o.drift_tolerance >= 0) || o.max_steps < 1) bad("negative redistance_every, drift_tolerance or max_steps");
   if (has_speed(o) && (!std::isfinite(o.speed.diffusion) || o.speed.diffusion < 0)) bad("speed diffusion bound must be >= 0");
   if (band.half_width() < 2.0) bad("the band half-width must be at least 2 voxels");
+  if (has_speed(o)) {
+    const std::uint32_t n = o.speed.needs;
+    const SpeedFields& f = o.fields;
+    auto missing = [&](std::uint32_t bit, bool given, const char* name) {
+      if ((n & bit) && !given) bad(std::string("the speed reads the field '") + name + "', which was not given");
+    };
+    missing(kNeedsDist, bool(f.dist), "dist");
+    missing(kNeedsDistGradient, bool(f.dist_gradient), "dgx/dgy/dgz/dn (the gradient of dist)");
+    missing(kNeedsImage, bool(f.image), "img");
+    missing(kNeedsEdge, bool(f.edge), "edge");
+    missing(kNeedsRoi, bool(f.roi), "roi");
+  }
   if (!(o.track_distance > 0 && o.track_distance <= 1)) bad("track_distance must be in (0, 1] voxels");
 }
 

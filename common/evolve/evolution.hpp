@@ -84,6 +84,7 @@ struct StepInfo {
 
 struct EvolutionOptions {
   SpeedFunction speed;          // no eval: no normal motion
+  SpeedFields fields;           // those the speed reads
   Velocity velocity;
   Scheme scheme = Scheme::Upwind1;
   Hamiltonian hamiltonian = Hamiltonian::Godunov;

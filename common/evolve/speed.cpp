@@ -30,6 +30,12 @@ std::uint32_t needs_of(const formula::Program& p) {
   if (p.uses_var(Var::K) || p.uses_var(Var::k1) || p.uses_var(Var::k2)) needs |= kNeedsPrincipal;
   if (p.uses_var(Var::kavg)) needs |= kNeedsMeanAverage | kNeedsMean;
   if (p.uses_var(Var::grad)) needs |= kNeedsGradNorm;
+  if (p.uses_var(Var::dist)) needs |= kNeedsDist;
+  if (p.uses_var(Var::dgx) || p.uses_var(Var::dgy) || p.uses_var(Var::dgz)) needs |= kNeedsDistGradient;
+  if (p.uses_var(Var::dn)) needs |= kNeedsDistGradient | kNeedsNormal;
+  if (p.uses_var(Var::img)) needs |= kNeedsImage;
+  if (p.uses_var(Var::edge)) needs |= kNeedsEdge;
+  if (p.uses_var(Var::roi)) needs |= kNeedsRoi;
   return needs;
 }
 
@@ -48,6 +54,14 @@ std::array<const float*, formula::kVarCount> inputs_of(const SpeedBatch& b, std:
   in[int(Var::k1)] = b.k1;
   in[int(Var::k2)] = b.k2;
   in[int(Var::grad)] = b.grad;
+  in[int(Var::dist)] = b.dist;
+  in[int(Var::dgx)] = b.dgx;
+  in[int(Var::dgy)] = b.dgy;
+  in[int(Var::dgz)] = b.dgz;
+  in[int(Var::dn)] = b.dn;
+  in[int(Var::img)] = b.img;
+  in[int(Var::edge)] = b.edge;
+  in[int(Var::roi)] = b.roi;
   // Per-batch scalars broadcast: t, h, kavg.
   scalars.assign(std::size_t(3) * std::size_t(b.count), 0.0f);
   std::fill_n(scalars.begin(), b.count, float(b.time));
@@ -84,11 +98,6 @@ SpeedFunction formula_speed(std::string_view text, const std::map<std::string, d
   formula::CompileOptions options;
   options.constants = constants;
   formula::SplitProgram split = formula::compile_split_by_curvature(text, options);
-  for (const formula::Program* p : {&split.without_curvature, &split.with_curvature})
-    for (Var f : {Var::dist, Var::dgx, Var::dgy, Var::dgz, Var::dn, Var::img, Var::edge, Var::roi})
-      if (p->uses_var(f))
-        throw Error(ErrorCode::InvalidArgument, "speed",
-                    std::string("the field '") + formula::var_name(f) + "' is not available here (it needs a session that carries it)");
   SpeedFunction s;
   s.name = std::string(text);
   s.needs = needs_of(split.without_curvature) | needs_of(split.with_curvature);

@@ -22,6 +22,8 @@
 #include <string_view>
 #include <vector>
 
+#include "core/vec3.hpp"
+
 namespace levelset::evolve {
 
 enum SpeedNeeds : std::uint32_t {
@@ -32,6 +34,22 @@ enum SpeedNeeds : std::uint32_t {
   kNeedsPrincipal = 1u << 3,  // K, k1, k2 (and H)
   kNeedsMeanAverage = 1u << 4,  // kavg: area-weighted mean of H over the surface
   kNeedsGradNorm = 1u << 5,   // |grad u| (central)
+  kNeedsDist = 1u << 6,       // dist (field)
+  kNeedsDistGradient = 1u << 7,  // dgx dgy dgz, and dn = grad dist . n (needs the normal)
+  kNeedsImage = 1u << 8,      // img (field)
+  kNeedsEdge = 1u << 9,       // edge (field)
+  kNeedsRoi = 1u << 10,       // roi (field)
+};
+
+// Fields a session may carry (thesis 4.9: the distance to a point cloud, an image, an edge
+// indicator, a region of influence), sampled at voxel centres in world units; called
+// concurrently. A speed that reads a field the options do not give is an error.
+struct SpeedFields {
+  std::function<double(const Vec3d&)> dist;
+  std::function<Vec3d(const Vec3d&)> dist_gradient;
+  std::function<double(const Vec3d&)> image;
+  std::function<double(const Vec3d&)> edge;
+  std::function<double(const Vec3d&)> roi;
 };
 
 struct SpeedBatch {
@@ -49,6 +67,14 @@ struct SpeedBatch {
   const float* k1 = nullptr;
   const float* k2 = nullptr;
   const float* grad = nullptr;      // |grad u|
+  const float* dist = nullptr;      // fields
+  const float* dgx = nullptr;
+  const float* dgy = nullptr;
+  const float* dgz = nullptr;
+  const float* dn = nullptr;
+  const float* img = nullptr;
+  const float* edge = nullptr;
+  const float* roi = nullptr;
 };
 
 struct SpeedOutput {
@@ -68,7 +94,7 @@ struct SpeedFunction {
 // A typed speed formula (formula/formula.hpp) with named constants: its top-level terms that
 // read curvatures (H K k1 k2 kavg) form the parabolic part, the others the advective part.
 // Only the inputs the formula reads are computed. The fields of a session (dist dgx dgy dgz
-// dn img edge roi) are not available to evolve yet: Error{InvalidArgument} naming the field.
+// dn img edge roi) come from EvolutionOptions::fields.
 // The diffusion bound is probed from the parabolic part (largest |beta_p| over curvatures of
 // size <= 1 / world unit, at least 0.05). Errors: those of formula::compile.
 SpeedFunction formula_speed(std::string_view formula, const std::map<std::string, double, std::less<>>& constants = {});

@@ -310,8 +310,8 @@ TEST(Evolution, ExtensionVelocitiesKeepTheDistanceProperty) {
 }
 
 // The built-ins are formulas now; hand-written C++ speeds must give the same evolution (the
-// thesis's formulas: mean-Gaussian eq. 5.2, 1 - eps kappa eq. 3.6, and a position-dependent
-// one standing in for the reconstruction's dn + dist H, whose fields need a session).
+// thesis's formulas: mean-Gaussian eq. 5.2, 1 - eps kappa eq. 3.6, the reconstruction's
+// dn + dist H with analytic fields, and a position-dependent one).
 TEST(Evolution, FormulasEvolveLikeHandWrittenSpeeds) {
   const auto shape = make_builtin_shape("torus");
   const NarrowBand band = band_of([&](const Vec3d& p) { return shape->distance(p); }, shape->bounds(), 40);
@@ -344,7 +344,23 @@ TEST(Evolution, FormulasEvolveLikeHandWrittenSpeeds) {
            o.parabolic[i] = 0.5f * b.mean[i];
          }
        },
-       kNeedsMean | kNeedsPosition, true, true, 0.5}};
+       kNeedsMean | kNeedsPosition, true, true, 0.5},
+      {"dn + dist*H",  // the reconstruction speed (thesis 5.1.3), dist = distance to a sphere's points
+       [](const SpeedBatch& b, const SpeedOutput& o) {
+         for (int i = 0; i < b.count; ++i) {
+           o.advective[i] = b.dgx[i] * b.nx[i] + b.dgy[i] * b.ny[i] + b.dgz[i] * b.nz[i];
+           o.parabolic[i] = b.dist[i] * b.mean[i];
+         }
+       },
+       kNeedsMean | kNeedsDist | kNeedsDistGradient | kNeedsNormal, true, true, 0.5}};
+  SpeedFields fields;
+  const Vec3d centre{0.02, -0.01, 0.03};
+  fields.dist = [centre](const Vec3d& p) { return std::abs(length(p - centre) - 0.55); };
+  fields.dist_gradient = [centre](const Vec3d& p) {
+    const Vec3d q = p - centre;
+    const double r = length(q);
+    return r > 0 ? q * ((r > 0.55 ? 1.0 : -1.0) / r) : Vec3d{};
+  };
   for (const Case& c : cases) {
     const SpeedFunction f = formula_speed(c.formula, {{"eps", 0.1}});
     EXPECT_EQ(f.needs, c.needs) << c.formula;
@@ -355,6 +371,7 @@ TEST(Evolution, FormulasEvolveLikeHandWrittenSpeeds) {
     hand.diffusion = f.diffusion;  // same time steps
     EvolutionOptions o;
     o.steps = 5;
+    o.fields = fields;
     o.speed = f;
     const NarrowBand a = evolve(band, o).band;
     o.speed = hand;
@@ -391,6 +408,8 @@ TEST(Evolution, RejectsBadOptions) {
   nothing.time = 0.1;
   EXPECT_THROW(evolve(band, nothing), Error);
   EXPECT_THROW(builtin_speed("warp-drive"), Error);
+  EvolutionOptions field = with_speed(formula_speed("dist"), 0.1);
+  EXPECT_THROW(evolve(band, field), Error);  // no dist field given
   EXPECT_THROW(constant_speed(NAN), Error);
 }
 
