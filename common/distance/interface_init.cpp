@@ -123,7 +123,7 @@ std::uint64_t init_interface(const NarrowBand& in, RedistanceDomain& w) {
         bool crossing = false;
         for (int a = 0; a < 3; ++a) {
           const int st = TileGeom<1>::kStride[a];
-          crossing |= ((tile[t - st] < 0.0f) != in_u) | ((tile[t + st] < 0.0f) != in_u);
+          crossing |= int((tile[t - st] < 0.0f) != in_u) | int((tile[t + st] < 0.0f) != in_u);
         }
         if (!crossing) return;
         dist[n] = static_cast<float>(subcell_distance(tile.data(), act.data(), t));
