@@ -8,6 +8,7 @@
 
 #include "core/error.hpp"
 #include "core/file_io.hpp"
+#include "core/suggest.hpp"
 
 namespace levelset::config {
 
@@ -218,21 +219,6 @@ class Parser {
   int place_line_ = 1, place_column_ = 1;
 };
 
-std::size_t edit_distance(std::string_view a, std::string_view b) {
-  std::vector<std::size_t> row(b.size() + 1);
-  for (std::size_t j = 0; j <= b.size(); ++j) row[j] = j;
-  for (std::size_t i = 1; i <= a.size(); ++i) {
-    std::size_t prev = row[0];
-    row[0] = i;
-    for (std::size_t j = 1; j <= b.size(); ++j) {
-      const std::size_t cur = row[j];
-      row[j] = std::min({row[j] + 1, row[j - 1] + 1, prev + (a[i - 1] == b[j - 1] ? 0 : 1)});
-      prev = cur;
-    }
-  }
-  return row[b.size()];
-}
-
 }  // namespace
 
 Set parse_config(std::string_view text, const ParseOptions& options) {
@@ -251,15 +237,7 @@ Set read_config_file(const std::string& path, const Limits& limits) {
 void check_keys(const Set& set, const std::vector<std::string>& allowed, std::string_view name) {
   for (const Entry& e : set.entries) {
     if (std::find(allowed.begin(), allowed.end(), e.key) != allowed.end()) continue;
-    std::string best;
-    std::size_t best_d = 3;
-    for (const std::string& a : allowed) {
-      const std::size_t d = edit_distance(e.key, a);
-      if (d < best_d) {
-        best_d = d;
-        best = a;
-      }
-    }
+    const std::string best = closest_name(e.key, allowed);
     std::string known;
     for (const std::string& a : allowed) known += (known.empty() ? "" : ", ") + a;
     throw Error(ErrorCode::InvalidArgument, std::string(name) + ":" + std::to_string(e.line) + ":" + std::to_string(e.column),

@@ -8,6 +8,7 @@
 #include <string>
 
 #include "core/error.hpp"
+#include "core/suggest.hpp"
 
 namespace levelset::formula {
 
@@ -383,36 +384,15 @@ class Parser {
 
   // " (did you mean 'x'?)" for a known name within edit distance 2, else "".
   std::string suggestion(const std::string& name, bool function) const {
-    auto distance = [](std::string_view a, std::string_view b) {
-      std::vector<std::size_t> row(b.size() + 1);
-      for (std::size_t j = 0; j <= b.size(); ++j) row[j] = j;
-      for (std::size_t i = 1; i <= a.size(); ++i) {
-        std::size_t prev = row[0];
-        row[0] = i;
-        for (std::size_t j = 1; j <= b.size(); ++j) {
-          const std::size_t cur = row[j];
-          row[j] = std::min({row[j] + 1, row[j - 1] + 1, prev + (a[i - 1] == b[j - 1] ? 0 : 1)});
-          prev = cur;
-        }
-      }
-      return row[b.size()];
-    };
-    std::string best;
-    std::size_t best_d = 3;
-    auto consider = [&](std::string_view cand) {
-      const std::size_t d = distance(name, cand);
-      if (d < best_d) {
-        best_d = d;
-        best = std::string(cand);
-      }
-    };
+    std::vector<std::string> names;
     if (function) {
-      for (const Function& f : kFunctions) consider(f.name);
+      for (const Function& f : kFunctions) names.emplace_back(f.name);
     } else {
-      for (const char* v : kVarNames) consider(v);
-      for (const auto& [k, v] : options_.constants) consider(k);
-      consider("pi");
+      for (const char* v : kVarNames) names.emplace_back(v);
+      for (const auto& [k, v] : options_.constants) names.push_back(k);
+      names.emplace_back("pi");
     }
+    const std::string best = closest_name(name, names);
     return best.empty() ? std::string() : " (did you mean '" + best + "'?)";
   }
 
