@@ -468,10 +468,12 @@ struct Caught {
   std::string where, reason, what;
 };
 
-Caught try_compile(std::string_view text, const CompileOptions& o = opts()) {
+// The Error that f() throws, if any.
+template <typename F>
+Caught caught(F&& f) {
   Caught c;
   try {
-    (void)compile(text, o);
+    f();
   } catch (const Error& e) {
     c.thrown = true;
     c.code = e.code();
@@ -482,18 +484,12 @@ Caught try_compile(std::string_view text, const CompileOptions& o = opts()) {
   return c;
 }
 
+Caught try_compile(std::string_view text, const CompileOptions& o = opts()) {
+  return caught([&] { (void)compile(text, o); });
+}
+
 Caught try_split(std::string_view text, const CompileOptions& o = opts()) {
-  Caught c;
-  try {
-    (void)compile_split_by_curvature(text, o);
-  } catch (const Error& e) {
-    c.thrown = true;
-    c.code = e.code();
-    c.where = e.where();
-    c.reason = e.reason();
-    c.what = e.what();
-  }
-  return c;
+  return caught([&] { (void)compile_split_by_curvature(text, o); });
 }
 
 std::vector<std::string> lines_of(const std::string& s) {
