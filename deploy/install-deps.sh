@@ -19,6 +19,10 @@ PACKAGES=(
   libgtest-dev libgmock-dev libbenchmark-dev libopenvdb-dev
   # real sample data: CGAL's meshes, point clouds and 3D images
   libcgal-demo
+  # applications: kd-tree for distances to point clouds (header-only)
+  libnanoflann-dev
+  # reconstruction benchmark reference: Open3D's screened Poisson (run by /usr/bin/python3)
+  python3-open3d
 )
 
 # Where CGAL's sample data is unpacked (tests and benchmarks look here, or in

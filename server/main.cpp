@@ -8,19 +8,13 @@
 #include <CLI/CLI.hpp>
 #include <tbb/global_control.h>
 
+#include "commands/command.hpp"
 #include "commands/commands.hpp"
 #include "core/error.hpp"
 #include "evolve/speed.hpp"
 #include "geometry/analytic_shapes.hpp"
 
-namespace {
-
-void add_common_options(CLI::App* sub, int& threads, std::string& stats) {
-  sub->add_option("--threads", threads, "Worker threads (default: all cores)")->check(CLI::Range(1, 1024));
-  sub->add_option("--stats", stats, "Write timings and sizes as JSON to FILE (or - for stdout)");
-}
-
-}  // namespace
+using levelset::cli::add_common_options;
 
 int main(int argc, char** argv) {
   CLI::App app{"levelsetd: narrow-band level-set computation (batch subcommands; daemon to come)"};
@@ -129,6 +123,8 @@ int main(int argc, char** argv) {
       ->check(CLI::NonNegativeNumber);
   add_common_options(evolve_cmd, threads, evolve.stats);
 
+  const std::vector<levelset::cli::Command> registered = levelset::cli::registered_commands(app, threads);
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -159,6 +155,8 @@ int main(int argc, char** argv) {
       }
       return levelset::cli::run_evolve(evolve);
     }
+    for (const levelset::cli::Command& command : registered)
+      if (*command.sub) return command.run();
   } catch (const levelset::Error& e) {
     std::fprintf(stderr, "levelsetd: %s\n", e.what());
     return 1;

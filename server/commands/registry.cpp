@@ -1,0 +1,19 @@
+// The list of self-registering subcommands (command.hpp). One line per subcommand.
+#include "commands/command.hpp"
+
+namespace levelset::cli {
+
+void add_common_options(CLI::App* sub, int& threads, std::string& stats) {
+  sub->add_option("--threads", threads, "Worker threads (default: all cores)")->check(CLI::Range(1, 1024));
+  sub->add_option("--stats", stats, "Write timings and sizes as JSON to FILE (or - for stdout)");
+}
+
+std::vector<Command> registered_commands(CLI::App& app, int& threads) {
+  std::vector<Command> commands;
+  (void)app;
+  (void)threads;
+  // commands.push_back(add_<name>_command(app, threads));
+  return commands;
+}
+
+}  // namespace levelset::cli
