@@ -234,13 +234,19 @@ Set read_config_file(const std::string& path, const Limits& limits) {
   return parse_config(bytes, options);
 }
 
+std::string place_of(const Entry& entry, std::string_view name) {
+  if (!entry.override_text.empty()) return "--set " + entry.override_text;
+  if (entry.line == 0) return "--set";  // a set created by an override
+  return std::string(name) + ":" + std::to_string(entry.line) + ":" + std::to_string(entry.column);
+}
+
 void check_keys(const Set& set, const std::vector<std::string>& allowed, std::string_view name) {
   for (const Entry& e : set.entries) {
     if (std::find(allowed.begin(), allowed.end(), e.key) != allowed.end()) continue;
     const std::string best = closest_name(e.key, allowed);
     std::string known;
     for (const std::string& a : allowed) known += (known.empty() ? "" : ", ") + a;
-    throw Error(ErrorCode::InvalidArgument, std::string(name) + ":" + std::to_string(e.line) + ":" + std::to_string(e.column),
+    throw Error(ErrorCode::InvalidArgument, place_of(e, name),
                 "unknown key '" + e.key + "'" + (best.empty() ? "" : " (did you mean '" + best + "'?)") +
                     "; known here: " + known);
   }
@@ -269,15 +275,17 @@ void set_override(Set& root, std::string_view assignment) {
     if (dot == std::string_view::npos) {
       if (e && e->is_set) throw Error(ErrorCode::ParseError, "--set", "'" + std::string(path) + "' is a set, not a value");
       if (!e) {
-        set->entries.push_back(Entry{std::string(key), 0, 0, false, {}, {}});
+        set->entries.push_back(Entry{std::string(key), 0, 0, false, {}, {}, {}});
         e = &set->entries.back();
       }
       e->value = parsed.entries[0].value;
+      e->line = e->column = 0;
+      e->override_text = std::string(assignment);
       return;
     }
     if (e && !e->is_set) throw Error(ErrorCode::ParseError, "--set", "'" + std::string(key) + "' is a value, not a set");
     if (!e) {
-      set->entries.push_back(Entry{std::string(key), 0, 0, true, {}, {}});
+      set->entries.push_back(Entry{std::string(key), 0, 0, true, {}, {}, {}});
       e = &set->entries.back();
     }
     set = &e->set;

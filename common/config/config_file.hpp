@@ -50,7 +50,11 @@ struct Entry {
   bool is_set = false;
   Value value;   // when !is_set
   Set set;       // when is_set
+  std::string override_text;  // "a.b=v" when set_override gave the value (line = column = 0)
 };
+
+// Where an entry is, for errors: "NAME:LINE:COLUMN", or "--set a.b=v" for an override.
+std::string place_of(const Entry& entry, std::string_view name);
 
 struct Limits {
   std::size_t max_bytes = std::size_t{1} << 20;

@@ -8,11 +8,11 @@ void add_common_options(CLI::App* sub, int& threads, std::string& stats) {
   sub->add_option("--stats", stats, "Write timings and sizes as JSON to FILE (or - for stdout)");
 }
 
+Command add_run_command(CLI::App& app, int& threads);
+
 std::vector<Command> registered_commands(CLI::App& app, int& threads) {
   std::vector<Command> commands;
-  (void)app;
-  (void)threads;
-  // commands.push_back(add_<name>_command(app, threads));
+  commands.push_back(add_run_command(app, threads));
   return commands;
 }
 

@@ -1,0 +1,102 @@
+// run_job / run_job_file (jobs/job.hpp): the checks every job shares, the dispatch to its
+// application, and the stats / log files.
+#include <chrono>
+#include <filesystem>
+#include <fstream>
+#include <mutex>
+
+#include "core/error.hpp"
+#include "core/suggest.hpp"
+#include "jobs/applications.hpp"
+#include "jobs/job.hpp"
+
+namespace levelset::jobs {
+
+namespace fs = std::filesystem;
+
+const std::vector<ApplicationEntry>& applications() {
+  static const std::vector<ApplicationEntry> list = {
+      {"evolve", run_evolve_job, "move the input surface with a speed formula (thesis 4.7)"},
+  };
+  return list;
+}
+
+std::vector<std::string> job_application_names() {
+  std::vector<std::string> names;
+  for (const ApplicationEntry& a : applications()) names.emplace_back(a.name);
+  return names;
+}
+
+JobResult run_job(const config::Set& job, const JobOptions& options_in) {
+  const auto t0 = std::chrono::steady_clock::now();
+  const config::Entry* app_entry = job.find("job");
+  if (app_entry == nullptr || app_entry->is_set)
+    throw Error(ErrorCode::InvalidArgument, options_in.name,
+                "a job file starts with 'job = NAME' (one of the applications)");
+  const ApplicationEntry* app = nullptr;
+  for (const ApplicationEntry& a : applications())
+    if (a.name == app_entry->value.text) app = &a;
+  if (app == nullptr) {
+    std::string known;
+    for (const ApplicationEntry& a : applications()) known += (known.empty() ? "" : ", ") + std::string(a.name);
+    const std::string best = closest_name(app_entry->value.text, job_application_names());
+    throw Error(ErrorCode::InvalidArgument, config::place_of(*app_entry, options_in.name),
+                "unknown application '" + app_entry->value.text + "'" +
+                    (best.empty() ? "" : " (did you mean '" + best + "'?)") + "; known: " + known);
+  }
+  config::check_keys(job, {"job", "input", "raster", "output", std::string(app->name)}, options_in.name);
+
+  std::error_code ec;
+  fs::create_directories(options_in.output_dir, ec);
+  if (ec) throw Error(ErrorCode::IoError, options_in.output_dir, "cannot create the output directory: " + ec.message());
+
+  // The log goes to OUTDIR/STEM.log and to the caller's sink, each line once.
+  const std::string log_path = (fs::path(options_in.output_dir) / (stem(options_in.name) + ".log")).string();
+  auto log_file = std::make_shared<std::ofstream>(log_path, std::ios::trunc);
+  if (!*log_file) throw Error(ErrorCode::IoError, log_path, "cannot write the log");
+  auto log_mutex = std::make_shared<std::mutex>();
+  JobOptions options = options_in;
+  options.log = [log_file, log_mutex, sink = options_in.log, t0](std::string_view line) {
+    const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    char stamp[32];
+    std::snprintf(stamp, sizeof stamp, "[%8.2f s] ", s);
+    std::lock_guard<std::mutex> lock(*log_mutex);
+    *log_file << stamp << line << '\n';
+    log_file->flush();
+    if (sink) sink(std::string(stamp) + std::string(line));
+  };
+
+  JobContext context(job, options);
+  context.log("job " + std::string(app->name) + ": " + std::string(app->summary));
+  app->run(context);
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  context.log("done in " + std::to_string(seconds) + " s");
+
+  JobResult result;
+  result.application = std::string(app->name);
+  result.seconds = seconds;
+  result.outputs = context.outputs();
+  result.outputs.push_back(log_path);
+  const std::string stats_path = (fs::path(options.output_dir) / (stem(options.name) + ".stats.json")).string();
+  result.outputs.push_back(stats_path);
+  result.stats = context.stats();
+  result.stats["job"] = result.application;
+  result.stats["name"] = options.name;
+  result.stats["seconds"]["total"] = seconds;
+  result.stats["outputs"] = result.outputs;
+  std::ofstream stats_file(stats_path, std::ios::trunc);
+  stats_file << result.stats.dump(2) << '\n';
+  if (!stats_file) throw Error(ErrorCode::IoError, stats_path, "cannot write the stats");
+  return result;
+}
+
+JobResult run_job_file(const std::string& path, const std::vector<std::string>& overrides, JobOptions options) {
+  config::Set job = config::read_config_file(path);
+  for (const std::string& o : overrides) config::set_override(job, o);
+  options.name = path;
+  options.base_dir = fs::path(path).parent_path().string();
+  if (options.base_dir.empty()) options.base_dir = ".";
+  return run_job(job, options);
+}
+
+}  // namespace levelset::jobs
