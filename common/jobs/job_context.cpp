@@ -33,8 +33,14 @@ std::string join(const std::vector<std::string>& names) {
 }
 
 std::string cgal_data_dir() {
+  // $LEVELSET_CGAL_DATA names the data directory (meshes/, points_3/, images/) or, as in
+  // deploy/install-deps.sh, the directory the tarball was unpacked into (holding data/).
   const char* env = std::getenv("LEVELSET_CGAL_DATA");
-  if (env != nullptr && *env != '\0') return std::string(env) + "/data";
+  if (env != nullptr && *env != '\0') {
+    std::error_code ec;
+    if (fs::is_directory(fs::path(env) / "meshes", ec)) return env;
+    return std::string(env) + "/data";
+  }
   return "/usr/local/share/levelset/cgal-data/data";
 }
 
