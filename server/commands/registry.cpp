@@ -9,10 +9,18 @@ void add_common_options(CLI::App* sub, int& threads, std::string& stats) {
 }
 
 Command add_run_command(CLI::App& app, int& threads);
+Command add_offset_command(CLI::App& app, int& threads);
+Command add_fair_command(CLI::App& app, int& threads);
+Command add_minmax_command(CLI::App& app, int& threads);
+Command add_csg_command(CLI::App& app, int& threads);
 
 std::vector<Command> registered_commands(CLI::App& app, int& threads) {
   std::vector<Command> commands;
   commands.push_back(add_run_command(app, threads));
+  commands.push_back(add_offset_command(app, threads));
+  commands.push_back(add_fair_command(app, threads));
+  commands.push_back(add_minmax_command(app, threads));
+  commands.push_back(add_csg_command(app, threads));
   return commands;
 }
 
