@@ -272,19 +272,5 @@ std::string stem(std::string_view job_name) {
   return s.empty() ? "job" : s;
 }
 
-nlohmann::json measures_json(const MeshMeasures& m) {
-  return {{"area", m.area},
-          {"volume", m.volume},
-          {"vertices", m.vertices},
-          {"triangles", m.faces},
-          {"components", m.components},
-          {"genus", m.genus},
-          {"euler_characteristic", m.euler_characteristic},
-          {"watertight", m.watertight},
-          {"manifold", m.manifold},
-          {"oriented", m.oriented},
-          {"bounds_min", {m.bounds.min.x, m.bounds.min.y, m.bounds.min.z}},
-          {"bounds_max", {m.bounds.max.x, m.bounds.max.y, m.bounds.max.z}}};
-}
 
 }  // namespace levelset::jobs

@@ -28,6 +28,7 @@
 #include "core/vec3.hpp"
 #include "grid/narrow_band.hpp"
 #include "io/triangle_mesh.hpp"
+#include "jobs/measures_json.hpp"
 #include "surface/mesh_measures.hpp"
 #include "surface/surface_result.hpp"
 
@@ -101,8 +102,6 @@ class JobContext {
   nlohmann::json stats_ = nlohmann::json::object();
   std::vector<std::string> outputs_;
 };
-
-nlohmann::json measures_json(const MeshMeasures& m);
 
 // The output stem of a job name: its file name without ".conf" ("job" when empty).
 std::string stem(std::string_view job_name);

@@ -13,6 +13,8 @@ Command add_offset_command(CLI::App& app, int& threads);
 Command add_fair_command(CLI::App& app, int& threads);
 Command add_minmax_command(CLI::App& app, int& threads);
 Command add_csg_command(CLI::App& app, int& threads);
+Command add_path_command(CLI::App& app, int& threads);
+Command add_voronoi_command(CLI::App& app, int& threads);
 
 std::vector<Command> registered_commands(CLI::App& app, int& threads) {
   std::vector<Command> commands;
@@ -21,6 +23,8 @@ std::vector<Command> registered_commands(CLI::App& app, int& threads) {
   commands.push_back(add_fair_command(app, threads));
   commands.push_back(add_minmax_command(app, threads));
   commands.push_back(add_csg_command(app, threads));
+  commands.push_back(add_path_command(app, threads));
+  commands.push_back(add_voronoi_command(app, threads));
   return commands;
 }
 

@@ -7,25 +7,12 @@
 #include <nlohmann/json.hpp>
 
 #include "apps/shape_measures.hpp"
+#include "jobs/measures_json.hpp"
 
 namespace levelset::cli {
 
-inline nlohmann::json shape_json(const apps::ShapeMeasures& m) {
-  return {{"area", m.area},
-          {"volume", m.volume},
-          {"components", m.components},
-          {"genus", m.genus},
-          {"vertices", m.vertices},
-          {"triangles", m.triangles},
-          {"watertight", m.watertight},
-          {"sphere_fit",
-           {{"center", {m.sphere.center.x, m.sphere.center.y, m.sphere.center.z}},
-            {"radius", m.sphere.radius},
-            {"rms_deviation", m.sphere.rms_deviation},
-            {"max_deviation", m.sphere.max_deviation}}},
-          {"mean_curvature",
-           {{"mean", m.curvature.mean}, {"variance", m.curvature.variance}, {"max_abs", m.curvature.max_abs}}}};
-}
+using jobs::shape_json;
+
 
 inline void print_shape(std::FILE* out, const char* label, const apps::ShapeMeasures& m) {
   std::fprintf(out, "  %s: area %.6g volume %.6g components %llu genus %g; sphere fit r %.6g rms %.3g; H mean %.4g var %.4g max|H| %.4g\n",
