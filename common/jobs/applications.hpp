@@ -23,6 +23,10 @@ struct ApplicationEntry {
 const std::vector<ApplicationEntry>& applications();
 
 void run_evolve_job(JobContext& context);
+void run_offset_job(JobContext& context);
+void run_fair_job(JobContext& context);
+void run_minmax_job(JobContext& context);
+void run_csg_job(JobContext& context);
 
 // For the jobs that drive the evolution engine: the options from a set with the keys of the
 // evolve job (speed, c, eps, constants, steps | time, scheme, rk, cfl, redistance_every,

@@ -83,7 +83,7 @@ nlohmann::json evolution_json(const evolve::EvolutionResult& r) {
 }
 
 void run_evolve_job(JobContext& ctx) {
-  const config::Set& input = ctx.section("input", {"shape", "mesh", "lsg"});
+  const config::Set& input = ctx.section("input", JobContext::input_keys());
   const config::Set& s = ctx.section("evolve", {"speed", "c", "eps", "constants", "steps", "time", "scheme", "rk", "cfl",
                                                 "redistance_every", "drift_tolerance", "extension", "report_every"});
   const NarrowBand band = ctx.input_band(input);

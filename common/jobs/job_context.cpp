@@ -203,23 +203,33 @@ NarrowBand JobContext::input_band(const config::Set& input) const {
     f.origin = bounds.min - Vec3d{pad, pad, pad};
     return f;
   };
+  // Placement (shapes and meshes): x -> scale * x + translate.
+  const Vec3d translate = vec3(input, "translate", {0, 0, 0});
+  const double scale = number(input, "scale", 1.0, 1e-6, 1e6);
   if (has(input, "shape")) {
     const auto shape = make_builtin_shape(word(input, "shape", "", builtin_shape_names()));
+    const BBox b = shape->bounds();
+    const BBox placed{b.min * scale + translate, b.max * scale + translate};
     SdfBuildOptions o;
-    o.frame = frame_for(shape->bounds());
+    o.frame = frame_for(placed);
     o.progress = options_.progress;
     log("input: built-in " + shape->name());
-    return build_from_sdf([&](const Vec3d& p) { return shape->distance(p); }, shape->bounds(), o).band;
+    return build_from_sdf([&](const Vec3d& p) { return scale * shape->distance((p - translate) / scale); }, placed, o)
+        .band;
   }
   if (has(input, "mesh")) {
     const std::string path = input_path(input, "mesh");
-    const MeshReadResult read = read_mesh(path);
+    MeshReadResult read = read_mesh(path);
+    for (Vec3d& v : read.mesh.vertices) v = v * scale + translate;
     CptOptions o;
     o.frame = frame_for(read.mesh.bounds());
     o.progress = options_.progress;
     log("input: " + path + " (" + std::to_string(read.mesh.triangles.size()) + " triangles), closest point transform");
     return closest_point_transform(read.mesh, o).band;
   }
+  if (has(input, "translate") || has(input, "scale"))
+    throw Error(ErrorCode::InvalidArgument, place(input, has(input, "scale") ? "scale" : "translate"),
+                "a saved level set (lsg) cannot be moved or scaled here");
   const std::string path = input_path(input, "lsg");
   log("input: " + path);
   return load_lsg(path).band;

@@ -77,8 +77,11 @@ class JobContext {
   Raster raster(int fallback_resolution = 128, double fallback_band = 3) const;
 
   // The level set of an input set: `shape` (built-in analytic), `mesh` (closest point
-  // transform of a triangle mesh) or `lsg` (a saved band), on the raster's grid.
+  // transform of a triangle mesh) or `lsg` (a saved band), on the raster's grid; shapes and
+  // meshes may be placed with `scale = s` and `translate = (x, y, z)` (x -> s x + t).
+  // The input set's keys are the caller's to check (input_keys() lists these).
   NarrowBand input_band(const config::Set& input) const;
+  static std::vector<std::string> input_keys() { return {"shape", "mesh", "lsg", "scale", "translate"}; }
 
   // Outputs (paths recorded in outputs(); the mesh measures go to stats()["mesh"]).
   void write_band(const NarrowBand& band, std::string_view suffix = "");

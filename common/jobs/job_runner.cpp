@@ -17,6 +17,10 @@ namespace fs = std::filesystem;
 const std::vector<ApplicationEntry>& applications() {
   static const std::vector<ApplicationEntry> list = {
       {"evolve", run_evolve_job, "move the input surface with a speed formula (thesis 4.7)"},
+      {"offset", run_offset_job, "offset surfaces, and +D then -D (thesis 5.1.1)"},
+      {"fair", run_fair_job, "fairing by curvature flows (thesis 3.1, 5.1.2)"},
+      {"minmax", run_minmax_job, "feature-preserving min/max flow to a steady state (thesis 3.3)"},
+      {"csg", run_csg_job, "union, intersection, difference of two level sets (thesis 3.5, 5.1.4)"},
   };
   return list;
 }
