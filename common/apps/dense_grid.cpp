@@ -76,4 +76,18 @@ DenseGrid dense_grid_for_resolution(const BBox& bounds, int resolution, std::uin
   return dense_grid_for_voxel_size(bounds, bounds.longest_side() / resolution, max_voxels);
 }
 
+BBox padded_problem_bounds(const std::vector<Vec3d>& points, const NarrowBand* obstacles, double padding) {
+  BBox box;
+  for (const Vec3d& p : points) box.extend(p);
+  if (obstacles != nullptr && obstacles->active_voxel_count() > 0) {
+    const BBox bb = obstacles->active_world_bounds();
+    box.extend(bb.min);
+    box.extend(bb.max);
+  }
+  const double pad = std::max(padding * box.longest_side(), 0.01);
+  box.min -= Vec3d{pad, pad, pad};
+  box.max += Vec3d{pad, pad, pad};
+  return box;
+}
+
 }  // namespace levelset::apps

@@ -14,9 +14,11 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <vector>
 #include <string_view>
 
 #include "core/bbox.hpp"
+#include "grid/narrow_band.hpp"
 #include "core/vec3.hpp"
 
 namespace levelset::apps {
@@ -55,5 +57,9 @@ DenseGrid dense_grid_for_voxel_size(const BBox& bounds, double voxel_size,
 // h = bounds.longest_side() / resolution.
 DenseGrid dense_grid_for_resolution(const BBox& bounds, int resolution,
                                     std::uint64_t max_voxels = kDefaultMaxGridVoxels);
+
+// The default box of a path or Voronoi problem: around `points` and the active voxels of
+// `obstacles` (may be null), padded by `padding` x its longest side (at least 0.01).
+BBox padded_problem_bounds(const std::vector<Vec3d>& points, const NarrowBand* obstacles, double padding);
 
 }  // namespace levelset::apps

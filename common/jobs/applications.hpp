@@ -27,6 +27,8 @@ void run_offset_job(JobContext& context);
 void run_fair_job(JobContext& context);
 void run_minmax_job(JobContext& context);
 void run_csg_job(JobContext& context);
+void run_path_job(JobContext& context);
+void run_voronoi_job(JobContext& context);
 
 // For the jobs that drive the evolution engine: the options from a set with the keys of the
 // evolve job (speed, c, eps, constants, steps | time, scheme, rk, cfl, redistance_every,

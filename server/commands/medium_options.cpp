@@ -89,15 +89,7 @@ Medium load_medium(const MediumArgs& a, const std::vector<Vec3d>& points) {
       if (!(b[0] < b[3] && b[1] < b[4] && b[2] < b[5]))
         throw Error(ErrorCode::InvalidArgument, "--bounds", "expected min < max on every axis");
     } else {
-      for (const Vec3d& p : points) box.extend(p);
-      if (m.band && m.band->active_voxel_count() > 0) {
-        const BBox bb = m.band->active_world_bounds();
-        box.extend(bb.min);
-        box.extend(bb.max);
-      }
-      const double pad = std::max(a.padding * box.longest_side(), 0.01);
-      box.min -= Vec3d{pad, pad, pad};
-      box.max += Vec3d{pad, pad, pad};
+      box = apps::padded_problem_bounds(points, m.band.get(), a.padding);
     }
     m.grid = a.voxel_size > 0 ? apps::dense_grid_for_voxel_size(box, a.voxel_size)
                               : apps::dense_grid_for_resolution(box, a.resolution > 0 ? a.resolution : 128);

@@ -86,7 +86,74 @@ def check_csg_knot_sphere(run):
         assert s["after"]["watertight"], s["after"]
 
 
+def tangent_path_length(a, b, radius):
+    """Shortest path from a to b around a ball of `radius` at the origin: straight when the
+    segment misses the ball, else two tangent segments and a great-circle arc."""
+    na, nb = math.dist(a, (0, 0, 0)), math.dist(b, (0, 0, 0))
+    theta = math.acos(max(-1.0, min(1.0, sum(x * y for x, y in zip(a, b)) / (na * nb))))
+    ta, tb = math.acos(radius / na), math.acos(radius / nb)
+    if theta <= ta + tb:
+        return math.dist(a, b)
+    return math.sqrt(na * na - radius * radius) + math.sqrt(nb * nb - radius * radius) + radius * (theta - ta - tb)
+
+
+def read_path(path):
+    pts = [tuple(map(float, l.split())) for l in open(path) if l.strip() and not l.startswith("#")]
+    return pts, sum(math.dist(p, q) for p, q in zip(pts, pts[1:]))
+
+
+def check_path_sphere(run):
+    a, b = (-2, 0, 0), (1.8, 0.6, 0.2)
+    exact = tangent_path_length(a, b, 1.0)
+    s = run([])
+    pts, length = read_path([p for p in s["outputs"] if p.endswith(".path.txt")][0])
+    assert abs(length - s["path"]["length"]) < 1e-9 * exact, (length, s["path"]["length"])
+    assert abs(length / exact - 1) < 0.01, ("length", length, "exact", exact)
+    assert abs(s["path"]["arrival_time"] / exact - 1) < 0.01, ("travel time", s["path"]["arrival_time"], exact)
+    assert math.dist(pts[0], a) < 1e-9 and math.dist(pts[-1], b) < 1e-9, (pts[0], pts[-1])
+    h = s["path"]["voxel_size"]
+    assert min(math.dist(p, (0, 0, 0)) for p in pts) > 1 - h, "the path enters the obstacle"
+    # Uniform cost 2: the same path, twice the time.
+    s2 = run(["--set", "path.cost=2"])
+    assert abs(s2["path"]["arrival_time"] / (2 * s["path"]["arrival_time"]) - 1) < 1e-6, s2["path"]
+
+
+def read_nrrd(path):
+    import numpy
+    data = open(path, "rb").read()
+    head, raw = data.split(b"\n\n", 1)
+    fields = dict(l.split(": ", 1) for l in head.decode().splitlines()[1:] if ": " in l)
+    sizes = list(map(int, fields["sizes"].split()))
+    dtype = {"int32": "<i4", "float": "<f4"}[fields["type"]]
+    return numpy.frombuffer(raw, dtype=dtype).reshape(sizes[::-1])  # z, y, x
+
+
+def check_voronoi_seeds(run):
+    import numpy
+    s = run([])
+    v = s["voronoi"]
+    labels = read_nrrd([p for p in s["outputs"] if p.endswith(".labels.nrrd")][0])
+    nz, ny, nx = labels.shape
+    h, origin = v["voxel_size"], v["origin"]
+    seeds = numpy.array([(0.2, 0.3, 0.4), (0.8, 0.7, 0.5), (0.5, 0.1, 0.9), (0.4, 0.8, 0.1)])
+    z, y, x = numpy.meshgrid(numpy.arange(nz), numpy.arange(ny), numpy.arange(nx), indexing="ij")
+    nodes = numpy.stack([origin[0] + h * x, origin[1] + h * y, origin[2] + h * z], axis=-1)
+    d = numpy.linalg.norm(nodes[..., None, :] - seeds, axis=-1)
+    nearest = d.argmin(axis=-1)
+    ds = numpy.sort(d, axis=-1)
+    clear = (ds[..., 1] - ds[..., 0]) > 2 * h  # farther than about a voxel from a bisector
+    assert (labels >= 0).all(), "every node reached"
+    agree = (labels[clear] == nearest[clear]).mean()
+    assert agree == 1.0, ("labels off the bisectors agree with the nearest seed", agree)
+    assert sum(v["regions"].values()) == labels.size and v["unreached"] == 0, v
+    t = read_nrrd([p for p in s["outputs"] if p.endswith(".time.nrrd")][0])
+    err = numpy.abs(t - ds[..., 0]).max()
+    assert err < 0.5 * h, ("travel time vs distance to the nearest seed", err, h)
+
+
 CHECKS = {
+    "path_sphere": check_path_sphere,
+    "voronoi_seeds": check_voronoi_seeds,
     "evolve_dumbbell": check_evolve_dumbbell,
     "offset_knot": check_offset_knot,
     "fair_elephant": check_fair_elephant,
