@@ -1,5 +1,7 @@
 #include "evolve/speed.hpp"
 
+#include <algorithm>
+
 #include <array>
 #include <cmath>
 #include <memory>
@@ -165,6 +167,13 @@ SpeedFunction builtin_speed(std::string_view name, double c, double eps) {
   std::string known;
   for (const std::string& n : builtin_speed_names()) known += (known.empty() ? "" : ", ") + n;
   throw Error(ErrorCode::InvalidArgument, "speed", "unknown speed '" + std::string(name) + "' (known: " + known + ")");
+}
+
+SpeedFunction speed_from_text(std::string_view name_or_formula, double c, double eps,
+                              const std::map<std::string, double, std::less<>>& constants) {
+  const auto names = builtin_speed_names();
+  if (std::find(names.begin(), names.end(), name_or_formula) != names.end()) return builtin_speed(name_or_formula, c, eps);
+  return formula_speed(name_or_formula, constants);
 }
 
 }  // namespace levelset::evolve

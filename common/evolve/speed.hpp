@@ -112,4 +112,8 @@ SpeedFunction curvature_regularized(double c, double eps);  // "c - c*eps*H" (eq
 SpeedFunction builtin_speed(std::string_view name, double c = 1.0, double eps = 0.1);
 std::vector<std::string> builtin_speed_names();
 
+// A built-in name (with c and eps) when it is one, else a formula with named constants.
+SpeedFunction speed_from_text(std::string_view name_or_formula, double c, double eps,
+                              const std::map<std::string, double, std::less<>>& constants);
+
 }  // namespace levelset::evolve

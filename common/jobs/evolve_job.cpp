@@ -31,18 +31,14 @@ evolve::EvolutionOptions evolution_options_from(JobContext& ctx, const config::S
   evolve::EvolutionOptions o;
   const std::string speed = ctx.text(s, "speed", "");
   if (speed.empty()) throw Error(ErrorCode::InvalidArgument, ctx.options().name, "the evolve set needs 'speed = ...'");
-  const auto names = evolve::builtin_speed_names();
-  if (std::find(names.begin(), names.end(), speed) != names.end()) {
-    o.speed = evolve::builtin_speed(speed, ctx.number(s, "c", 1.0, -1e6, 1e6), ctx.number(s, "eps", 0.1, 0, 1e6));
-  } else {
-    std::map<std::string, double, std::less<>> constants;
-    if (const config::Entry* c = s.find("constants"); c != nullptr && c->is_set)
-      for (const config::Entry& e : c->set.entries) constants[e.key] = ctx.number(c->set, e.key, 0, -1e300, 1e300);
-    try {
-      o.speed = evolve::formula_speed(speed, constants);
-    } catch (const Error& e) {
-      throw Error(e.code(), ctx.place(s, "speed") + " (" + e.where() + ")", e.reason());
-    }
+  std::map<std::string, double, std::less<>> constants;
+  if (const config::Entry* c = s.find("constants"); c != nullptr && c->is_set)
+    for (const config::Entry& e : c->set.entries) constants[e.key] = ctx.number(c->set, e.key, 0, -1e300, 1e300);
+  try {
+    o.speed = evolve::speed_from_text(speed, ctx.number(s, "c", 1.0, -1e6, 1e6), ctx.number(s, "eps", 0.1, 0, 1e6),
+                                      constants);
+  } catch (const Error& e) {
+    throw Error(e.code(), ctx.place(s, "speed") + " (" + e.where() + ")", e.reason());
   }
   const bool has_steps = ctx.has(s, "steps"), has_time = ctx.has(s, "time");
   if (has_steps == has_time)

@@ -39,22 +39,17 @@ int run_evolve(const EvolveArgs& args) {
   const auto t1 = std::chrono::steady_clock::now();
   evolve::EvolutionOptions options;
   if (!args.speed.empty()) {
-    const auto names = evolve::builtin_speed_names();
-    if (std::find(names.begin(), names.end(), args.speed) != names.end()) {
-      options.speed = evolve::builtin_speed(args.speed, args.c, args.eps);
-    } else {
-      std::map<std::string, double, std::less<>> constants;
-      for (const std::string& kv : args.constants) {
-        const std::size_t eq = kv.find('=');
-        char* end = nullptr;
-        const std::string value = eq == std::string::npos ? "" : kv.substr(eq + 1);
-        const double v = std::strtod(value.c_str(), &end);
-        if (eq == std::string::npos || eq == 0 || value.empty() || end != value.c_str() + value.size())
-          throw Error(ErrorCode::InvalidArgument, "--const", "expected NAME=VALUE, got '" + kv + "'");
-        constants[kv.substr(0, eq)] = v;
-      }
-      options.speed = evolve::formula_speed(args.speed, constants);
+    std::map<std::string, double, std::less<>> constants;
+    for (const std::string& kv : args.constants) {
+      const std::size_t eq = kv.find('=');
+      char* end = nullptr;
+      const std::string value = eq == std::string::npos ? "" : kv.substr(eq + 1);
+      const double v = std::strtod(value.c_str(), &end);
+      if (eq == std::string::npos || eq == 0 || value.empty() || end != value.c_str() + value.size())
+        throw Error(ErrorCode::InvalidArgument, "--const", "expected NAME=VALUE, got '" + kv + "'");
+      constants[kv.substr(0, eq)] = v;
     }
+    options.speed = evolve::speed_from_text(args.speed, args.c, args.eps, constants);
   }
   if (!args.velocity.empty()) {
     options.velocity.kind = evolve::Velocity::Kind::Constant;
