@@ -784,6 +784,10 @@ EvolutionResult evolve(const NarrowBand& band, const EvolutionOptions& options) 
       const double f = options.steps > 0 ? double(step) / options.steps : t / options.time;
       options.progress.on_progress(std::min(1.0, f), "evolve");
     }
+    if (options.stop_when && options.stop_when(info)) {
+      result.message = "stopped by stop_when after " + std::to_string(step) + " steps";
+      break;
+    }
   }
   if (motion > 0) {
     // Leave a tidy band: every value within W h, every voxel within W h of the front active.

@@ -38,8 +38,9 @@
 //   closest point x - u n on the zero level, so the speed is constant along normals and the
 //   distance property is kept.
 // Output: EvolutionResult; the band after the last completed step (never a partial step).
-// Stopping: steps reached, time reached, max_steps, the cancel token (checked between steps:
-//   stop = Cancelled), or a NaN/Inf entering the band (stop = NonFinite with a message naming
+// Stopping: steps reached, time reached, max_steps, stop_when returning true after a step
+//   (stop = Completed, message says so; for convergence tests), the cancel token (checked
+//   between steps: stop = Cancelled), or a NaN/Inf entering the band (stop = NonFinite with a message naming
 //   the step and voxel; the band is the last good state). Nothing is thrown for these.
 // Units: world units and time; StepInfo.dt in time units.
 // Cost per step: O(active voxels) per RK stage (x3 for RK3) plus the band upkeep O(active
@@ -98,6 +99,9 @@ struct EvolutionOptions {
   bool extension = false;
   double track_distance = 0.5;  // voxels the front may move between band upkeeps, in (0, 1]
   std::function<void(const StepInfo&)> on_step;  // after every step, from the calling thread
+  // After every step (after on_step), from the calling thread: true ends the run there
+  // (stop = Completed). Empty: never. The band is tidied as for any other end.
+  std::function<bool(const StepInfo&)> stop_when;
   ProgressHook progress;        // fraction of steps / time; cancel checked between steps
 };
 

@@ -15,6 +15,7 @@ Command add_minmax_command(CLI::App& app, int& threads);
 Command add_csg_command(CLI::App& app, int& threads);
 Command add_path_command(CLI::App& app, int& threads);
 Command add_voronoi_command(CLI::App& app, int& threads);
+Command add_reconstruct_command(CLI::App& app, int& threads);
 
 std::vector<Command> registered_commands(CLI::App& app, int& threads) {
   std::vector<Command> commands;
@@ -25,6 +26,7 @@ std::vector<Command> registered_commands(CLI::App& app, int& threads) {
   commands.push_back(add_csg_command(app, threads));
   commands.push_back(add_path_command(app, threads));
   commands.push_back(add_voronoi_command(app, threads));
+  commands.push_back(add_reconstruct_command(app, threads));
   return commands;
 }
 

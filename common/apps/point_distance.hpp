@@ -1,0 +1,112 @@
+// Distance to an unorganised point set: a kd-tree (nanoflann) over the points, the exact
+// unsigned distance d(x) with its direction, and per-voxel local surface fits.
+//
+// PointIndex: builds the kd-tree once (serial, O(N log N)); its queries are const and safe to
+//   run concurrently. Points are copied; indices refer to the input order. Ties between
+//   equidistant points are broken by the tree, identically for every thread count.
+// point_distance: for each query position x, d(x) = min_i |x - p_i| (exact, double) and the
+//   unit direction (x - p*) / d of the gradient of d (zero where d = 0). TBB over queries.
+// LocalFit (per voxel centre x, from the k nearest points p_i):
+//   d      distance to the nearest point;
+//   a      x - c, c the centroid of the k points;
+//   s      the second moments S = mean (x - p_i)(x - p_i)^T (xx, xy, xz, yy, yz, zz).
+//   With a unit normal n and the mean curvature H (= k1 + k2) of a surface through x,
+//   signed_offset(n, H) = a.n - (H / 4) (tr S - n^T S n) estimates the signed distance of x
+//   to the surface the points sample: the mean offset of x from the points along n, minus
+//   the mean amount mean(rho_i^2) H / 4 by which points at tangential distance rho_i lie
+//   below a tangent plane of a surface with that mean curvature (exact to second order for
+//   isotropic neighbourhoods). Averaging over k points divides the noise by sqrt(k); with
+//   k = 1 it is the distance to the nearest point's tangent plane.
+// point_fit_field: the LocalFit of every active voxel of `where` (a NarrowBand used as the
+//   set of voxels), in the band's value order; O(voxels * k log N), TBB over bricks,
+//   identical for any thread count. Progress per brick batch, cancellable.
+// Units: world. Errors: Error{InvalidArgument} for an empty point set, k < 1 or k > 256;
+//   Error{NonFinite} for a non-finite point; Error{Cancelled} through the hook.
+#pragma once
+
+#include <algorithm>
+#include <cstdint>
+#include <memory>
+#include <span>
+#include <utility>
+#include <vector>
+
+#include "core/progress.hpp"
+#include "core/vec3.hpp"
+#include "grid/narrow_band.hpp"
+
+namespace levelset::apps {
+
+class PointIndex {
+ public:
+  explicit PointIndex(std::span<const Vec3d> points);
+  ~PointIndex();
+  PointIndex(const PointIndex&) = delete;
+  PointIndex& operator=(const PointIndex&) = delete;
+
+  std::size_t size() const { return points_.size(); }
+  const std::vector<Vec3d>& points() const { return points_; }
+
+  struct Nearest {
+    std::uint32_t index = 0;
+    double distance = 0.0;
+  };
+  Nearest nearest(const Vec3d& x) const;
+  // Up to k nearest points, closest first; returns how many were written (min(k, size)).
+  int k_nearest(const Vec3d& x, int k, std::uint32_t* indices, double* distances_squared) const;
+  // All points within `radius` of x (index, squared distance), unordered; `out` is cleared.
+  void within(const Vec3d& x, double radius, std::vector<std::pair<std::uint32_t, double>>& out) const;
+
+ private:
+  struct Tree;
+  std::vector<Vec3d> points_;
+  std::unique_ptr<Tree> tree_;
+};
+
+struct PointDistanceOptions {
+  ProgressHook progress;
+};
+
+struct PointDistanceResult {
+  std::vector<double> distance;  // one per query
+  std::vector<Vec3d> direction;  // (x - closest point) / distance, or zero
+  std::vector<std::uint32_t> closest;  // index of the closest point
+  double seconds = 0.0;
+};
+
+PointDistanceResult point_distance(const PointIndex& index, std::span<const Vec3d> queries,
+                                   const PointDistanceOptions& options = {});
+
+struct LocalFit {
+  float d = 0.0f;
+  float ax = 0.0f, ay = 0.0f, az = 0.0f;
+  float sxx = 0.0f, sxy = 0.0f, sxz = 0.0f, syy = 0.0f, syz = 0.0f, szz = 0.0f;
+
+  // max_correction bounds the curvature term (a neighbourhood that wraps around a thin
+  // part is no local patch; the correction is meant for ~0.1 voxel).
+  double signed_offset(const Vec3d& n, double mean_curvature, double max_correction) const {
+    const double an = double(ax) * n.x + double(ay) * n.y + double(az) * n.z;
+    const double nsn = double(sxx) * n.x * n.x + double(syy) * n.y * n.y + double(szz) * n.z * n.z +
+                       2.0 * (double(sxy) * n.x * n.y + double(sxz) * n.x * n.z + double(syz) * n.y * n.z);
+    const double tangential = std::max(0.0, double(sxx) + double(syy) + double(szz) - nsn);
+    return an - std::clamp(0.25 * mean_curvature * tangential, -max_correction, max_correction);
+  }
+};
+
+// The fit at one position (k nearest points of the index). Thread-safe.
+LocalFit local_fit(const PointIndex& index, const Vec3d& x, int k);
+
+struct PointFitFieldOptions {
+  int neighbors = 8;  // k
+  ProgressHook progress;
+};
+
+struct PointFitFieldResult {
+  std::vector<LocalFit> fits;  // one per active voxel of `where`, band value order
+  double seconds = 0.0;
+};
+
+PointFitFieldResult point_fit_field(const PointIndex& index, const NarrowBand& where,
+                                    const PointFitFieldOptions& options);
+
+}  // namespace levelset::apps

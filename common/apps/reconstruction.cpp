@@ -1,0 +1,563 @@
+#include "apps/reconstruction.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <atomic>
+#include <cstdio>
+#include <deque>
+#include <limits>
+#include <optional>
+#include <string>
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include "apps/point_distance.hpp"
+#include "core/error.hpp"
+#include "distance/redistance.hpp"
+#include "evolve/evolution.hpp"
+#include "grid/band_accessor.hpp"
+#include "grid/band_builder.hpp"
+#include "grid/build_from_sdf.hpp"
+#include "surface/marching_cubes.hpp"
+
+namespace levelset::apps {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+// The coarsest level's attraction: beta = -clamp(gain * offset / h): a front within
+// 1 / gain voxels of its target moves a fraction 0.5 gain / (1 + 6 w) of the way per step
+// (forward Euler at cfl 0.5 with the curvature's explicit limit); 3 converges in a few
+// steps without overshoot for w >= 0.1.
+constexpr double kAttractionGain = 3.0;
+// Snap: voxels within this many voxels of the front take their fit's offset (the marching
+// cubes read |u| < 1 h; the margin covers the front's move).
+constexpr double kSnapWindow = 1.5;
+// Bound on the fits' curvature correction (voxels): a neighbourhood wrapping round a thin
+// part is no local patch. 0.5 measured best on the knot (0.25: bias under k = 24, 1: noise).
+constexpr double kMaxCorrection = 0.5;
+
+double seconds_since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
+
+void require(bool ok, const std::string& reason) {
+  if (!ok) throw Error(ErrorCode::InvalidArgument, "reconstruct", reason);
+}
+
+void validate(const std::vector<Vec3d>& points, const ReconstructionOptions& o) {
+  for (std::size_t i = 0; i < points.size(); ++i)
+    if (!std::isfinite(points[i].x) || !std::isfinite(points[i].y) || !std::isfinite(points[i].z))
+      throw Error(ErrorCode::NonFinite, "reconstruct", "point " + std::to_string(i) + " is not finite");
+  require(points.size() >= 4, "need at least 4 points, got " + std::to_string(points.size()));
+  if (!std::isfinite(o.voxel_size) || !std::isfinite(o.half_width) || !std::isfinite(o.shell_offset) ||
+      !std::isfinite(o.curvature_weight) || !std::isfinite(o.tolerance))
+    throw Error(ErrorCode::NonFinite, "reconstruct", "non-finite option");
+  require((o.resolution > 0) != (o.voxel_size > 0.0), "give exactly one of resolution and voxel_size");
+  require(o.resolution >= 0 && o.voxel_size >= 0.0, "resolution and voxel_size must not be negative");
+  require(o.half_width >= 2.0 && o.half_width <= 8.0, "half_width must be in [2, 8] voxels");
+  require(o.resolution == 0 || o.resolution >= int(2 * (o.half_width + 2)) + 8,
+          "resolution " + std::to_string(o.resolution) + " is too small for the band");
+  require(o.levels >= 1 && o.levels <= 6, "levels must be in [1, 6]");
+  require(o.shell_offset >= 1.0 && o.shell_offset <= 16.0, "shell_offset must be in [1, 16] voxels");
+  require(o.neighbors >= 1 && o.neighbors <= 256, "neighbors must be in [1, 256]");
+  require(o.curvature_weight >= 0.0, "curvature_weight must be >= 0");
+  require(o.max_steps >= 1, "max_steps must be >= 1");
+  require(o.snap_passes >= 0 && o.snap_passes <= 16, "snap_passes must be in [0, 16]");
+  require(o.tolerance > 0.0, "tolerance must be > 0");
+  require(o.max_resolution >= 16, "max_resolution must be >= 16");
+}
+
+// The band with its frame moved by `offset` (values, topology and signs unchanged).
+NarrowBand translated(const NarrowBand& band, const Vec3d& offset) {
+  GridFrame frame = band.frame();
+  frame.origin = frame.origin + offset;
+  std::vector<BrickRecord> records(band.brick_count());
+  for (std::uint32_t b = 0; b < band.brick_count(); ++b)
+    records[b] = {band.bricks()[b].coord, band.bricks()[b].active, band.inside_mask(b)};
+  std::vector<float> values(band.values().begin(), band.values().end());
+  return NarrowBand::assemble(frame, std::move(records), std::move(values), band.far_inside());
+}
+
+// Start band on the coarsest level: the outer component of {d < offset} (see the header).
+NarrowBand start_shell(const PointIndex& index, const BBox& box, const Vec3d& origin, double h, double offset,
+                       double half_width, const ProgressHook& progress) {
+  const Vec3d far = (box.max - origin) / h;
+  const long nx = long(std::ceil(far.x + offset + half_width + 3)), ny = long(std::ceil(far.y + offset + half_width + 3)),
+             nz = long(std::ceil(far.z + offset + half_width + 3));
+  if (double(nx) * double(ny) * double(nz) > double(1u << 27))
+    throw Error(ErrorCode::LimitExceeded, "reconstruct",
+                "the coarsest level's start grid exceeds 2^27 voxels: use more levels or a coarser resolution");
+  const std::size_t total = std::size_t(nx * ny * nz);
+  auto at = [&](long i, long j, long k) { return std::size_t((k * ny + j) * nx + i); };
+  std::vector<float> dist(total);
+  tbb::parallel_for(tbb::blocked_range<long>(0, nz), [&](const tbb::blocked_range<long>& r) {
+    for (long k = r.begin(); k != r.end(); ++k) {
+      progress.check("reconstruct start");
+      for (long j = 0; j < ny; ++j)
+        for (long i = 0; i < nx; ++i)
+          dist[at(i, j, k)] = float(index.nearest(origin + Vec3d{double(i), double(j), double(k)} * h).distance / h);
+    }
+  });
+  // Flood fill of the outside from the grid's faces (they lie beyond the shell by construction).
+  std::vector<std::uint8_t> outside(total, 0);
+  std::deque<std::size_t> queue;
+  auto seed = [&](long i, long j, long k) {
+    const std::size_t n = at(i, j, k);
+    if (!outside[n] && dist[n] > offset) {
+      outside[n] = 1;
+      queue.push_back(n);
+    }
+  };
+  for (long k = 0; k < nz; ++k)
+    for (long j = 0; j < ny; ++j)
+      for (long i = 0; i < nx; ++i)
+        if (i == 0 || j == 0 || k == 0 || i == nx - 1 || j == ny - 1 || k == nz - 1) seed(i, j, k);
+  while (!queue.empty()) {
+    const std::size_t n = queue.front();
+    queue.pop_front();
+    const long i = long(n % std::size_t(nx)), j = long((n / std::size_t(nx)) % std::size_t(ny)),
+               k = long(n / std::size_t(nx * ny));
+    if (i > 0) seed(i - 1, j, k);
+    if (i < nx - 1) seed(i + 1, j, k);
+    if (j > 0) seed(i, j - 1, k);
+    if (j < ny - 1) seed(i, j + 1, k);
+    if (k > 0) seed(i, j, k - 1);
+    if (k < nz - 1) seed(i, j, k + 1);
+  }
+  progress.check("reconstruct start");
+  // Signed value in world units: d - offset outside and in the shell; inside the cavity a
+  // negative value no larger than the distance to the outer shell (d - offset is 1-Lipschitz).
+  auto sdf = [&](const Vec3d& p) {
+    const Vec3d q = (p - origin) / h;
+    const long i = std::clamp(long(std::lround(q.x)), 0L, nx - 1), j = std::clamp(long(std::lround(q.y)), 0L, ny - 1),
+               k = std::clamp(long(std::lround(q.z)), 0L, nz - 1);
+    const std::size_t n = at(i, j, k);
+    const double v = double(dist[n]) - offset;
+    if (outside[n]) return v * h;
+    return (v < 0.0 ? v : -v - 1e-3) * h;
+  };
+  SdfBuildOptions build;
+  build.frame = GridFrame{h, origin, half_width};
+  build.progress = progress;
+  BBox bounds = box;
+  const Vec3d pad{(offset + 1) * h, (offset + 1) * h, (offset + 1) * h};
+  bounds.min = bounds.min - pad;
+  bounds.max = bounds.max + pad;
+  const NarrowBand raw = build_from_sdf(sdf, bounds, build).band;
+  RedistanceOptions redo;
+  redo.progress = progress;
+  return redistance(raw, redo).band;
+}
+
+// A per-voxel field of `coarse` (band value order) at voxel c of the grid with half its
+// voxel size and the same origin: the trilinear interpolant at c / 2, the mean of the 1, 2, 4
+// or 8 coarse voxels around it. NaN when one of them is not active.
+double coarse_field_at(BandAccessor& acc, const NarrowBand& coarse, const std::vector<float>& field, const Coord& c) {
+  const int lx = c.x >> 1, ly = c.y >> 1, lz = c.z >> 1;
+  const int hx = lx + (c.x & 1), hy = ly + (c.y & 1), hz = lz + (c.z & 1);
+  double sum = 0.0;
+  int n = 0;
+  for (int z = lz; z <= hz; ++z)
+    for (int y = ly; y <= hy; ++y)
+      for (int x = lx; x <= hx; ++x) {
+        const Coord q{x, y, z};
+        const std::uint32_t b = acc.locate(brick_of(q));
+        if (b == kNoBrick) return std::nan("");
+        const Brick& br = coarse.bricks()[b];
+        const int i = local_index(q);
+        if (!br.active.test(i)) return std::nan("");
+        sum += double(field[br.value_offset + br.slot(i)]);
+        ++n;
+      }
+  return sum / n;
+}
+
+// A per-voxel field of `band` at its voxel c; NaN when c is not active.
+double field_at(BandAccessor& acc, const NarrowBand& band, const std::vector<float>& field, const Coord& c) {
+  const std::uint32_t b = acc.locate(brick_of(c));
+  if (b == kNoBrick) return std::nan("");
+  const Brick& br = band.bricks()[b];
+  const int i = local_index(c);
+  return br.active.test(i) ? double(field[br.value_offset + br.slot(i)]) : std::nan("");
+}
+
+// The band resampled (trilinear) at half its voxel size, same origin: the fine voxels whose
+// 1-8 coarse neighbours are active and whose value is within W h; the others take the sign
+// of the coarse voxel they lie in. Every coarse brick gives its 8 fine bricks (TBB over
+// coarse bricks, assembled in key order: deterministic). No redistance: the snap that
+// follows rewrites the values near the front and redistances.
+NarrowBand upsample(const NarrowBand& coarse, double half_width, const ProgressHook& progress) {
+  const double h = 0.5 * coarse.voxel_size();
+  const double limit = half_width * h;
+  // A fine voxel's value differs from that of the coarse voxel c / 2 it touches by at most
+  // one coarse voxel (1-Lipschitz): beyond limit + h_c it is not in the band.
+  const double far = limit + coarse.voxel_size();
+  const std::vector<float> values(coarse.values().begin(), coarse.values().end());
+  BandBuilder builder(GridFrame{h, coarse.origin(), half_width});
+  tbb::parallel_for(tbb::blocked_range<std::uint32_t>(0, std::uint32_t(coarse.brick_count()), 4),
+                    [&](const tbb::blocked_range<std::uint32_t>& r) {
+                      progress.check("reconstruct upsample");
+                      BandAccessor acc(coarse);
+                      std::vector<float> dense(512);
+                      for (std::uint32_t cb = r.begin(); cb != r.end(); ++cb) {
+                        const Coord cbc = coarse.bricks()[cb].coord;
+                        for (int sub = 0; sub < 8; ++sub) {
+                          const Coord fb{2 * cbc.x + (sub & 1), 2 * cbc.y + ((sub >> 1) & 1), 2 * cbc.z + ((sub >> 2) & 1)};
+                          const Coord o = brick_origin(fb);
+                          BrickMask active{}, inside{};
+                          for (int n = 0; n < 512; ++n) {
+                            const Coord c = o + local_coord(n);
+                            const Coord parent{c.x >> 1, c.y >> 1, c.z >> 1};
+                            const std::optional<float> near = acc.probe(parent);
+                            bool in = near ? *near < 0.0f : acc.is_inside(parent);
+                            if (near && std::abs(double(*near)) <= far) {
+                              const double v = coarse_field_at(acc, coarse, values, c);
+                              if (std::isfinite(v)) {
+                                in = v < 0.0;
+                                if (std::abs(v) <= limit) {
+                                  active.set(n);
+                                  dense[std::size_t(n)] = float(v);
+                                }
+                              }
+                            }
+                            if (in) inside.set(n);
+                          }
+                          builder.add_brick(fb, active, inside, dense.data());
+                        }
+                      }
+                    });
+  return builder.finish(coarse.far_inside());
+}
+
+// Mean front motion of the coarsest level's flow: the speed function adds |beta| of the
+// voxels within one voxel of the front (fixed point, so the sum is the same in any order:
+// deterministic for any thread count); stop_when turns it into voxels per step.
+struct MotionMeter {
+  static constexpr double kScale = 1048576.0;
+  std::atomic<std::uint64_t> sum{0};
+  std::atomic<std::uint64_t> count{0};
+  double take_mean() {
+    const std::uint64_t n = count.exchange(0);
+    const std::uint64_t s = sum.exchange(0);
+    return n > 0 ? double(s) / kScale / double(n) : 0.0;
+  }
+};
+
+// The coarsest level's speed (see the header), reading the cached fits (on the fly off the
+// cache).
+evolve::SpeedFunction fit_speed(const NarrowBand& cache, const std::vector<LocalFit>& fits, const PointIndex& index,
+                                int neighbors, double weight, MotionMeter& meter) {
+  const double h = cache.voxel_size();
+  const Vec3d origin = cache.origin();
+  evolve::SpeedFunction s;
+  s.name = "point-attraction";
+  s.needs = evolve::kNeedsPosition | evolve::kNeedsNormal | evolve::kNeedsMean;
+  s.has_advective = true;
+  s.has_parabolic = weight > 0.0;
+  s.diffusion = weight * h;
+  s.eval = [&cache, &fits, &index, &meter, neighbors, weight, h, origin](const evolve::SpeedBatch& b,
+                                                                           const evolve::SpeedOutput& out) {
+    BandAccessor acc(cache);
+    std::uint64_t sum = 0, count = 0;
+    for (int i = 0; i < b.count; ++i) {
+      const Coord c{int(std::lround((double(b.x[i]) - origin.x) / h)), int(std::lround((double(b.y[i]) - origin.y) / h)),
+                    int(std::lround((double(b.z[i]) - origin.z) / h))};
+      const std::uint32_t br = acc.locate(brick_of(c));
+      LocalFit fit;
+      const int n = local_index(c);
+      if (br != kNoBrick && cache.bricks()[br].active.test(n)) {
+        const Brick& brick = cache.bricks()[br];
+        fit = fits[brick.value_offset + brick.slot(n)];
+      } else {
+        fit = local_fit(index, cache.world(c), neighbors);
+      }
+      const Vec3d nrm{double(b.nx[i]), double(b.ny[i]), double(b.nz[i])};
+      const double H = std::clamp(double(b.mean[i]), -1.0 / h, 1.0 / h);
+      const double u = double(b.d[i]);
+      const double front_offset = fit.signed_offset(nrm, H, kMaxCorrection * h) - u;
+      const double advective = -std::clamp(kAttractionGain * front_offset / h, -1.0, 1.0);
+      const double parabolic = -weight * std::min(double(fit.d), h) * H;
+      out.advective[i] = float(advective);
+      out.parabolic[i] = float(parabolic);
+      if (std::abs(u) < h) {
+        sum += std::uint64_t(std::lround(std::min(std::abs(advective + parabolic), 4.0) * MotionMeter::kScale));
+        ++count;
+      }
+    }
+    meter.sum.fetch_add(sum, std::memory_order_relaxed);
+    meter.count.fetch_add(count, std::memory_order_relaxed);
+  };
+  return s;
+}
+
+// Mean curvature H = div(grad u / |grad u|) by central differences (u a distance, so the
+// 1 / |grad u|^3 normalisation is near 1); the 18 neighbours must be in the band.
+double central_mean_curvature(BandAccessor& acc, const Coord& c, double u, double h, Vec3d& gradient) {
+  auto at = [&](int dx, int dy, int dz) { return double(acc.value(Coord{c.x + dx, c.y + dy, c.z + dz})); };
+  const double xp = at(1, 0, 0), xm = at(-1, 0, 0), yp = at(0, 1, 0), ym = at(0, -1, 0), zp = at(0, 0, 1),
+               zm = at(0, 0, -1);
+  const double ux = (xp - xm) / (2 * h), uy = (yp - ym) / (2 * h), uz = (zp - zm) / (2 * h);
+  gradient = {ux, uy, uz};
+  const double g2 = ux * ux + uy * uy + uz * uz;
+  if (g2 < 1e-12) return 0.0;
+  const double uxx = (xp - 2 * u + xm) / (h * h), uyy = (yp - 2 * u + ym) / (h * h), uzz = (zp - 2 * u + zm) / (h * h);
+  const double uxy = (at(1, 1, 0) - at(1, -1, 0) - at(-1, 1, 0) + at(-1, -1, 0)) / (4 * h * h);
+  const double uxz = (at(1, 0, 1) - at(1, 0, -1) - at(-1, 0, 1) + at(-1, 0, -1)) / (4 * h * h);
+  const double uyz = (at(0, 1, 1) - at(0, 1, -1) - at(0, -1, 1) + at(0, -1, -1)) / (4 * h * h);
+  const double num = uxx * (uy * uy + uz * uz) + uyy * (ux * ux + uz * uz) + uzz * (ux * ux + uy * uy) -
+                     2.0 * (ux * uy * uxy + ux * uz * uxz + uy * uz * uyz);
+  return num / (g2 * std::sqrt(g2));
+}
+
+// H of every active voxel of the band (band value order), clamped to +-1 / h; voxels whose
+// stencil leaves the band read the band limit (their H is only used far from the front).
+std::vector<float> mean_curvature_field(const NarrowBand& band) {
+  const double h = band.voxel_size();
+  std::vector<float> H(band.active_voxel_count());
+  tbb::parallel_for(tbb::blocked_range<std::uint32_t>(0, std::uint32_t(band.brick_count()), 8),
+                    [&](const tbb::blocked_range<std::uint32_t>& r) {
+                      BandAccessor acc(band);
+                      for (std::uint32_t b = r.begin(); b != r.end(); ++b) {
+                        std::size_t slot = band.bricks()[b].value_offset;
+                        band.for_each_active_in_brick(b, [&](const Coord& c, float u) {
+                          Vec3d g;
+                          H[slot++] = float(std::clamp(central_mean_curvature(acc, c, double(u), h, g), -1.0 / h, 1.0 / h));
+                        });
+                      }
+                    });
+  return H;
+}
+
+struct SnapPass {
+  double mean_change = 0.0;     // voxels, over the snapped voxels
+  std::uint64_t voxels = 0;     // snapped (fits computed)
+};
+
+// One snap pass (see the header): every voxel with |u| < window h takes the signed offset s
+// of its local fit along the level set's normal, moved by at most one voxel. Per-brick sums
+// added in brick order (deterministic).
+SnapPass snap_to_fits(NarrowBand& band, const PointIndex& index, int neighbors, double window, const NarrowBand& coarse,
+                      const std::vector<float>& coarse_curvature, const ProgressHook& progress) {
+  const double h = band.voxel_size();
+  const bool same_grid = coarse.voxel_size() == h;  // a single level: its own curvature
+  const float unset = std::numeric_limits<float>::quiet_NaN();
+  // 1. The front offset e = clamp(s - u, +-h) of every voxel within the window.
+  std::vector<float> offset(band.active_voxel_count(), unset);
+  tbb::parallel_for(tbb::blocked_range<std::uint32_t>(0, std::uint32_t(band.brick_count()), 8),
+                    [&](const tbb::blocked_range<std::uint32_t>& r) {
+                      progress.check("reconstruct snap");
+                      BandAccessor acc(band), coarse_acc(coarse);
+                      for (std::uint32_t b = r.begin(); b != r.end(); ++b) {
+                        std::size_t slot = band.bricks()[b].value_offset;
+                        band.for_each_active_in_brick(b, [&](const Coord& c, float value) {
+                          const std::size_t i = slot++;
+                          const double u = double(value);
+                          if (!(std::abs(u) < window * h)) return;
+                          const Vec3d g{double(acc.value(c + Coord{1, 0, 0})) - double(acc.value(c - Coord{1, 0, 0})),
+                                        double(acc.value(c + Coord{0, 1, 0})) - double(acc.value(c - Coord{0, 1, 0})),
+                                        double(acc.value(c + Coord{0, 0, 1})) - double(acc.value(c - Coord{0, 0, 1}))};
+                          const double gl = length(g);
+                          if (!(gl > 1e-6)) return;
+                          // The coarse level's curvature: smooth, where the fine one's
+                          // second differences would feed the fits' noise back.
+                          double H = same_grid ? field_at(coarse_acc, coarse, coarse_curvature, c)
+                                               : coarse_field_at(coarse_acc, coarse, coarse_curvature, c);
+                          if (!std::isfinite(H)) H = 0.0;
+                          const LocalFit fit = local_fit(index, band.world(c), neighbors);
+                          offset[i] = float(std::clamp(fit.signed_offset(g / gl, H, kMaxCorrection * h) - u, -h, h));
+                        });
+                      }
+                    });
+  // 2. Each voxel moves by the mean offset of its 3x3x3 neighbourhood: the offset is nearly
+  // constant along normals, so this averages the fits tangentially (their noise / ~3).
+  // Only voxels next to the front may change sign: no new bubbles or handles away from it
+  // (the coarse level fixed the topology).
+  std::vector<float> next(band.values().begin(), band.values().end());
+  std::vector<double> change(band.brick_count(), 0.0);
+  std::vector<std::uint32_t> count(band.brick_count(), 0);
+  tbb::parallel_for(tbb::blocked_range<std::uint32_t>(0, std::uint32_t(band.brick_count()), 8),
+                    [&](const tbb::blocked_range<std::uint32_t>& r) {
+                      BandAccessor acc(band);
+                      for (std::uint32_t b = r.begin(); b != r.end(); ++b) {
+                        std::size_t slot = band.bricks()[b].value_offset;
+                        band.for_each_active_in_brick(b, [&](const Coord& c, float value) {
+                          const std::size_t i = slot++;
+                          if (std::isnan(offset[i])) return;
+                          const double u = double(value);
+                          const bool inside = u < 0.0;
+                          bool at_front = false;
+                          double sum = 0.0;
+                          int n = 0;
+                          for (int dz = -1; dz <= 1; ++dz)
+                            for (int dy = -1; dy <= 1; ++dy)
+                              for (int dx = -1; dx <= 1; ++dx) {
+                                const Coord q{c.x + dx, c.y + dy, c.z + dz};
+                                const std::uint32_t qb = acc.locate(brick_of(q));
+                                if (qb == kNoBrick) continue;
+                                const Brick& br = band.bricks()[qb];
+                                const int qn = local_index(q);
+                                if (!br.active.test(qn)) continue;
+                                const std::size_t j = br.value_offset + br.slot(qn);
+                                if (std::abs(dx) + std::abs(dy) + std::abs(dz) == 1 && (band.values()[j] < 0.0f) != inside)
+                                  at_front = true;
+                                if (std::isnan(offset[j])) continue;
+                                sum += double(offset[j]);
+                                ++n;
+                              }
+                          double target = u + sum / n;
+                          if (!at_front && (target < 0.0) != inside) target = inside ? -1e-3 * h : 1e-3 * h;
+                          next[i] = float(target);
+                          change[b] += std::abs(target - u) / h;
+                          ++count[b];
+                        });
+                      }
+                    });
+  band.swap_values(next);
+  SnapPass pass;
+  for (std::size_t b = 0; b < change.size(); ++b) {
+    pass.mean_change += change[b];
+    pass.voxels += count[b];
+  }
+  if (pass.voxels > 0) pass.mean_change /= double(pass.voxels);
+  return pass;
+}
+
+}  // namespace
+
+ReconstructionResult reconstruct_surface(const std::vector<Vec3d>& input, const ReconstructionOptions& o) {
+  const auto t_start = Clock::now();
+  validate(input, o);
+  BBox box;
+  for (const Vec3d& p : input) box.extend(p);
+  const Vec3d centre = box.center();
+  const Vec3d ext = box.extent();
+  const double longest = std::max({ext.x, ext.y, ext.z});
+  require(longest > 0.0 && std::isfinite(longest), "all points are equal (or the extent is not finite)");
+  const double W = o.half_width;
+  const double h_final = o.voxel_size > 0.0 ? o.voxel_size : longest / (double(o.resolution) - 2.0 * (W + 2.0));
+  const double side = longest / h_final + 2.0 * (W + 2.0);
+  if (!(side <= double(o.max_resolution)))
+    throw Error(ErrorCode::LimitExceeded, "reconstruct",
+                "the final grid would have " + std::to_string(side) + " voxels along its longest side (max_resolution " +
+                    std::to_string(o.max_resolution) + ")");
+  auto log = [&](const std::string& line) {
+    if (o.log) o.log(line);
+  };
+
+  std::vector<Vec3d> points(input.size());
+  for (std::size_t i = 0; i < input.size(); ++i) points[i] = input[i] - centre;
+  BBox local;
+  local.min = box.min - centre;
+  local.max = box.max - centre;
+  const PointIndex index(points);
+
+  // Fewer levels when the coarsest would have under 24 voxels along the longest side.
+  int levels = o.levels;
+  while (levels > 1 && longest / (h_final * std::ldexp(1.0, levels - 1)) < 24.0) --levels;
+  const double h_coarse = h_final * std::ldexp(1.0, levels - 1);
+  const double pad = (o.shell_offset + W + 3.0) * h_coarse;
+  const Vec3d origin = local.min - Vec3d{pad, pad, pad};
+
+  ReconstructionResult result;
+  NarrowBand band;
+  char line[256];
+  for (int level = 0; level < levels; ++level) {
+    const auto t_level = Clock::now();
+    const double h = h_final * std::ldexp(1.0, levels - 1 - level);
+    ReconstructionStage stage;
+    stage.level = level;
+    stage.voxel_size = h;
+    if (level == 0) {
+      // The flow from the start shell.
+      band = start_shell(index, local, origin, h, o.shell_offset, W, o.progress);
+      stage.seconds_start = seconds_since(t_level);
+      // Cache of fits: the voxels within W + 2 of the start front.
+      RedistanceOptions grow;
+      grow.half_width = W + 2.0;
+      grow.progress = o.progress;
+      const NarrowBand cache = redistance(band, grow).band;
+      PointFitFieldOptions fit_options;
+      fit_options.neighbors = o.neighbors;
+      fit_options.progress = o.progress;
+      const auto t_fit = Clock::now();
+      const std::vector<LocalFit> fits = point_fit_field(index, cache, fit_options).fits;
+      stage.seconds_fit = seconds_since(t_fit);
+      stage.fit_voxels = fits.size();
+      MotionMeter meter;
+      evolve::EvolutionOptions ev;
+      ev.speed = fit_speed(cache, fits, index, o.neighbors, o.curvature_weight, meter);
+      ev.steps = o.max_steps;
+      ev.drift_tolerance = 0.1;  // the speed is constant along normals near the data: rare
+      ev.progress.cancel = o.progress.cancel;
+      ev.stop_when = [&](const evolve::StepInfo& si) {
+        stage.last_change = meter.take_mean() * si.dt / h;
+        o.progress.step(0.5 * double(si.step) / o.max_steps / levels, "reconstruct");
+        return stage.last_change < o.tolerance;
+      };
+      const auto t_flow = Clock::now();
+      evolve::EvolutionResult r = evolve::evolve(band, ev);
+      stage.seconds_flow = seconds_since(t_flow);
+      if (r.stop == evolve::StopReason::Cancelled) throw Error(ErrorCode::Cancelled, "reconstruct", "operation cancelled");
+      if (r.stop == evolve::StopReason::NonFinite) throw Error(ErrorCode::NonFinite, "reconstruct", r.message);
+      stage.steps = r.steps;
+      stage.converged = stage.last_change < o.tolerance;
+      stage.seconds_redistance = r.seconds.redistance;
+      band = std::move(r.band);
+    }
+    if (level > 0 || levels == 1) {
+      // The snap (on a single level: after the flow, with its own curvature).
+      const NarrowBand coarse = std::move(band);
+      const std::vector<float> coarse_curvature = mean_curvature_field(coarse);
+      const auto t_up = Clock::now();
+      band = level > 0 ? upsample(coarse, W, o.progress) : coarse;
+      stage.seconds_start += seconds_since(t_up);
+      for (int pass = 0; pass < o.snap_passes; ++pass) {
+        const auto t_fit = Clock::now();
+        const SnapPass snapped =
+            snap_to_fits(band, index, o.neighbors, kSnapWindow, coarse, coarse_curvature, o.progress);
+        stage.seconds_fit += seconds_since(t_fit);
+        stage.fit_voxels += snapped.voxels;
+        stage.last_change = snapped.mean_change;
+        ++stage.steps;
+        const auto t_redistance = Clock::now();
+        RedistanceOptions redo;
+        redo.half_width = W;
+        redo.progress = o.progress;
+        band = redistance(band, redo).band;
+        stage.seconds_redistance += seconds_since(t_redistance);
+        o.progress.step((double(level) + double(pass + 1) / o.snap_passes) / levels, "reconstruct");
+        if (stage.last_change < o.tolerance) break;
+      }
+      if (level > 0) stage.converged = stage.last_change < o.tolerance;
+    }
+    stage.active_voxels = band.active_voxel_count();
+    stage.seconds = seconds_since(t_level);
+    std::snprintf(line, sizeof line,
+                  "level %d: h %.4g, %s %d, change %.4f voxel, %llu voxels, %llu fits; start %.3f s, fits %.3f s, flow "
+                  "%.3f s, redistance %.3f s, total %.3f s",
+                  level, h, level == 0 ? "flow steps" : "snap passes", stage.steps, stage.last_change,
+                  static_cast<unsigned long long>(stage.active_voxels), static_cast<unsigned long long>(stage.fit_voxels),
+                  stage.seconds_start, stage.seconds_fit, stage.seconds_flow, stage.seconds_redistance, stage.seconds);
+    log(line);
+    result.steps += stage.steps;
+    result.stages.push_back(stage);
+  }
+
+  const auto t_mesh = Clock::now();
+  result.band = translated(band, centre);
+  MarchingCubesOptions mc;
+  mc.progress = o.progress;
+  result.mesh = marching_cubes(result.band, mc).mesh;
+  result.measures = measure_mesh(result.mesh);
+  result.seconds_mesh = seconds_since(t_mesh);
+  result.voxel_size = h_final;
+  result.seconds = seconds_since(t_start);
+  std::snprintf(line, sizeof line, "mesh: %zu triangles, %.3f s; total %.3f s", result.mesh.triangles.size(),
+                result.seconds_mesh, result.seconds);
+  log(line);
+  return result;
+}
+
+}  // namespace levelset::apps

@@ -1,0 +1,122 @@
+// reconstruct_surface: a watertight surface through unorganised points, no normals needed
+// (thesis 5.1.3, after Zhao, Osher and Fedkiw: the zero level of a narrow band moved by the
+// gradient flow of the distance to the data, with a curvature term, coarse to fine).
+//
+// Inputs: points (world units, finite, at least 4, not all equal); ReconstructionOptions.
+// Method:
+//   Grid. Points are shifted to their bounding-box centre (all work in float positions stays
+//   exact to ~1e-4 voxel), the final voxel size is h = L / (resolution - 2 (W + 2)) (L the
+//   longest side of the points' box: `resolution` voxels span the box padded by W + 2 on each
+//   side) or voxel_size; level l of `levels` uses h * 2^(levels - 1 - l).
+//   Start (coarsest level): the offset surface {d = shell_offset * h_c} of the unsigned
+//   distance d to the points, outer component only (flood fill from the grid's boundary over
+//   d > offset on a dense grid of the coarsest level; the cavity inside a closed shell is
+//   filled). Why this and not the bounding box the thesis starts from: the offset already
+//   follows concavities up to the offset radius, so the flow only has to travel ~offset
+//   voxels instead of carving deep concavities, and closing gaps up to 2 * offset * h_c
+//   between samples at the coarse level keeps the flood fill from leaking into the inside.
+//   Coarsest level, a flow: u_t + beta |grad u| = 0 with (beta > 0 outward, H = k1 + k2)
+//     beta = -clamp(g (s - u) / h, -1, 1) - w * min(d, h) * H,   g = 3,
+//   s = the signed distance of the voxel to the surface the k nearest points sample along the
+//   level set normal (apps/point_distance.hpp LocalFit::signed_offset: the point centroid's
+//   offset along n, corrected by the curvature of the level set), so s - u is the offset of
+//   the front from the data, constant along normals near the data: the flow keeps u a
+//   distance (no redistance per step) and moves the front by a fixed fraction of its offset
+//   per step: the gradient flow of E_2 = integral of s^2 (thesis eq. 5.4 with p = 2),
+//   converging geometrically to the zero of s, which is linear across a voxel (sub-voxel
+//   accurate where p = 1's unit speed grad d . n would chatter across the data); far from it
+//   the clamp gives unit speed, as p = 1. The second term is Zhao's d * H (p = 1
+//   normalisation, weight w): it smooths where the surface is away from the data and
+//   vanishes on it; it carries the coarse level's topology regularisation. Fits are cached
+//   on the voxels within W + 2 of the start front, computed on the fly elsewhere. One
+//   evolve call (evolve/evolution.hpp, first-order upwind, forward Euler) stopped by
+//   stop_when once the mean front motion (|beta| dt over the voxels within one voxel of the
+//   front) is below tolerance voxels per step, or after max_steps.
+//   Finer levels, a snap: the band is resampled (trilinear) at half the voxel size; then
+//   snap_passes times: every voxel within 1.5 voxels of the front computes its front offset
+//   e = clamp(s - u, -h, h) (s along the normal of the current u; the curvature correction
+//   uses the coarse level's H, interpolated, bounded by 0.5 h), moves by the mean e of its
+//   3x3x3 neighbourhood (tangential averaging of the fits' noise), may change sign only
+//   next to the front (no new bubbles or handles), and the band is redistanced (fast
+//   sweeping, W). This is the
+//   p = 2 flow's fixed point reached in one step (the flow with the gain g = 2 / dt is the
+//   snap), valid because the upsampled coarse front lies within about a voxel of the data.
+//   Passes stop early when the mean |change| of the snapped voxels is below tolerance.
+//   Output mesh: marching cubes of the final band (watertight by construction).
+// Output: ReconstructionResult (band in the input's world frame, mesh, measures, stages).
+// Cost: coarsest level O(steps * band) plus its fits; finer levels O(snap_passes * (voxels
+//   within 1.5 h of the front * k log N + band)) (fits and redistance); the coarsest level's
+//   dense start grid has (L / h_c + 2 pad)^3 voxels. Knot, 20k points, resolution 256:
+//   about 2 s on 2 cores (tests/bench/bench_reconstruct.cpp).
+// Threading: TBB throughout; the result is identical for any thread count.
+// Errors (thrown): Error{InvalidArgument} for fewer than 4 points, all points equal, bad
+//   options (resolution < 2 (W + 2) + 8, both or neither of resolution / voxel_size,
+//   half_width not in [2, 8], levels not in [1, 6], neighbors not in [1, 256], negative
+//   curvature weight, tolerance <= 0, max_steps < 1, snap_passes not in [0, 16],
+//   shell_offset not in [1, 16]);
+//   Error{NonFinite} for a non-finite point (naming it) or option; Error{LimitExceeded}
+//   when the final grid would exceed max_resolution voxels along a side or the coarsest
+//   level's dense grid 2^27 voxels; Error{Cancelled} through progress (checked between
+//   steps and inside each phase).
+// Log: options.log (may be empty) gets one line per level (steps, voxels, phase seconds) and
+//   one for the mesh, from the calling thread.
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "core/progress.hpp"
+#include "core/vec3.hpp"
+#include "grid/narrow_band.hpp"
+#include "io/triangle_mesh.hpp"
+#include "surface/mesh_measures.hpp"
+
+namespace levelset::apps {
+
+struct ReconstructionOptions {
+  int resolution = 256;         // voxels along the longest side of the padded box, or ...
+  double voxel_size = 0.0;      // ... the final voxel size (world); exactly one of the two > 0
+  double half_width = 3.0;      // band half-width W, voxels
+  int levels = 3;               // coarse-to-fine levels (voxel size halves per level)
+  double shell_offset = 2.0;    // start shell: offset of the points in coarsest-level voxels
+  int neighbors = 8;            // k points per local surface fit (more: smoother under noise)
+  double curvature_weight = 0.3;  // w of the coarsest level's flow
+  int max_steps = 120;          // coarsest level's flow
+  int snap_passes = 1;          // per finer level (more drift: 1 measured best)
+  double tolerance = 0.01;      // voxels: flow: mean front motion per step; snap: mean change
+  int max_resolution = 4096;    // cap on the final grid's longest side (voxels)
+  ProgressHook progress;
+  std::function<void(const std::string&)> log;  // progress lines; empty: none
+};
+
+struct ReconstructionStage {
+  int level = 0;                // 0 = coarsest (flow), then snaps
+  double voxel_size = 0.0;
+  int steps = 0;                // flow steps, or snap passes
+  bool converged = false;       // tolerance reached
+  double last_change = 0.0;     // voxels: flow: mean front motion per step; snap: mean change
+  std::uint64_t active_voxels = 0;
+  std::uint64_t fit_voxels = 0; // local fits computed (cache, or snapped voxels of all passes)
+  double seconds = 0.0;         // whole level
+  double seconds_start = 0.0;   // start shell, or upsampling
+  double seconds_fit = 0.0;     // fits (the snap passes' fits and updates)
+  double seconds_flow = 0.0;    // evolve (includes its redistances)
+  double seconds_redistance = 0.0;
+};
+
+struct ReconstructionResult {
+  NarrowBand band;              // final level, world frame of the input
+  TriangleMesh mesh;            // its zero level (marching cubes)
+  MeshMeasures measures;
+  std::vector<ReconstructionStage> stages;
+  int steps = 0;                // all levels (flow steps + snap passes)
+  double voxel_size = 0.0;      // final
+  double seconds_mesh = 0.0;
+  double seconds = 0.0;         // total
+};
+
+ReconstructionResult reconstruct_surface(const std::vector<Vec3d>& points, const ReconstructionOptions& options);
+
+}  // namespace levelset::apps

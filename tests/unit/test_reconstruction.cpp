@@ -1,0 +1,178 @@
+// Surface reconstruction from points (apps/reconstruction.hpp): analytic sphere and knot
+// samples, accuracy against the exact surfaces, topology, noise, bad inputs.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <limits>
+
+#include "apps/mesh_distance.hpp"
+#include "apps/point_distance.hpp"
+#include "apps/reconstruction.hpp"
+#include "apps/sample_points.hpp"
+#include "core/error.hpp"
+#include "evolve/evolution.hpp"
+#include "grid/build_from_sdf.hpp"
+#include "geometry/analytic_shapes.hpp"
+
+namespace levelset::apps {
+namespace {
+
+std::vector<Vec3d> samples(const AnalyticShape& shape, std::size_t n, double noise, std::uint64_t seed) {
+  SurfaceSampleOptions s;
+  s.count = n;
+  s.noise = noise;
+  s.seed = seed;
+  return sample_shape_surface(shape, s);
+}
+
+// Symmetric Chamfer distance between the mesh and the exact surface, in voxels.
+SurfaceDistance accuracy(const ReconstructionResult& r, const AnalyticShape& shape) {
+  SurfaceSampleOptions dense;
+  dense.count = 20000;
+  dense.seed = 99;
+  const std::vector<Vec3d> mesh_samples = sample_mesh_surface(r.mesh, dense);
+  const std::vector<Vec3d> true_samples = sample_shape_surface(shape, dense);
+  const MeshDistance to_mesh(r.mesh);
+  SurfaceDistance d = surface_distance(
+      mesh_samples, [&](const Vec3d& p) { return shape.distance(p); }, true_samples,
+      [&](const Vec3d& p) { return to_mesh.distance(p); });
+  d.chamfer /= r.voxel_size;
+  d.hausdorff /= r.voxel_size;
+  std::printf("    chamfer %.4f voxel, hausdorff %.4f voxel, %d steps, %.2f s\n", d.chamfer, d.hausdorff, r.steps, r.seconds);
+  return d;
+}
+
+// evolve's stop_when hook (added for the reconstruction's convergence test): the run ends
+// after the step where it first returns true, the band is that step's, the message says so.
+TEST(EvolutionStopWhen, EndsTheRunAfterTheStepItAccepts) {
+  SdfBuildOptions b;
+  const BBox box{{-1, -1, -1}, {1, 1, 1}};
+  b.frame = frame_for_resolution(box, 32, 3.0);
+  const NarrowBand band = build_from_sdf([](const Vec3d& p) { return length(p) - 0.5; }, box, b).band;
+  evolve::EvolutionOptions o;
+  o.speed = evolve::constant_speed(1.0);
+  o.steps = 50;
+  int calls = 0;
+  double time_at_stop = 0.0;
+  o.stop_when = [&](const evolve::StepInfo& si) {
+    ++calls;
+    time_at_stop = si.time;
+    return si.step == 3;
+  };
+  const evolve::EvolutionResult r = evolve::evolve(band, o);
+  EXPECT_EQ(r.stop, evolve::StopReason::Completed);
+  EXPECT_EQ(r.steps, 3);
+  EXPECT_EQ(calls, 3);
+  EXPECT_DOUBLE_EQ(r.time, time_at_stop);
+  EXPECT_NE(r.message.find("stop_when"), std::string::npos);
+  // Never true: the step count decides.
+  o.stop_when = [](const evolve::StepInfo&) { return false; };
+  o.steps = 5;
+  EXPECT_EQ(evolve::evolve(band, o).steps, 5);
+}
+
+TEST(PointDistance, ExactNearestAndDirection) {
+  const std::vector<Vec3d> pts = {{0, 0, 0}, {1, 0, 0}, {0, 2, 0}};
+  const PointIndex index(pts);
+  const std::vector<Vec3d> q = {{0.9, 0.1, 0}, {0, 0, 3}, {0, 2, 0}};
+  const PointDistanceResult r = point_distance(index, q);
+  EXPECT_NEAR(r.distance[0], std::sqrt(0.02), 1e-15);
+  EXPECT_EQ(r.closest[0], 1u);
+  EXPECT_NEAR(r.distance[1], 3.0, 1e-15);
+  EXPECT_NEAR(r.direction[1].z, 1.0, 1e-15);
+  EXPECT_EQ(r.distance[2], 0.0);
+}
+
+TEST(PointDistance, LocalFitIsThePlaneDistance) {
+  // Points on the plane z = 0: the fit's signed offset along +z is the height, any k.
+  std::vector<Vec3d> pts;
+  for (int i = -5; i <= 5; ++i)
+    for (int j = -5; j <= 5; ++j) pts.push_back({0.1 * i, 0.1 * j, 0.0});
+  const PointIndex index(pts);
+  for (int k : {1, 8, 20}) {
+    const LocalFit f = local_fit(index, {0.03, -0.02, 0.07}, k);
+    EXPECT_NEAR(f.signed_offset({0, 0, 1}, 0.0, 1.0), 0.07, 1e-6) << k;
+  }
+}
+
+TEST(Reconstruction, SphereIsSubVoxelAccurate) {
+  const auto sphere = make_sphere({0.1, -0.2, 0.3}, 1.0);
+  ReconstructionOptions o;
+  o.resolution = 64;
+  const ReconstructionResult r = reconstruct_surface(samples(*sphere, 8000, 0.0, 1), o);
+  EXPECT_TRUE(r.measures.watertight);
+  EXPECT_EQ(r.measures.components, 1u);
+  EXPECT_EQ(r.measures.genus, 0.0);
+  const SurfaceDistance d = accuracy(r, *sphere);
+  // Linear interpolation of an exact distance on a sphere of 27 voxels radius is ~0.01 voxel
+  // off; the fit (8 points) and the flow's convergence tolerance add a few hundredths. The
+  // largest deviation stays within one voxel (no spurious sheet or bump).
+  EXPECT_LT(d.chamfer, 0.1) << d.chamfer;
+  EXPECT_LT(d.hausdorff, 1.0) << d.hausdorff;
+}
+
+TEST(Reconstruction, KnotHasGenusOneAndSubVoxelChamfer) {
+  const auto knot = make_builtin_shape("knot");
+  ReconstructionOptions o;
+  o.resolution = 96;
+  const ReconstructionResult r = reconstruct_surface(samples(*knot, 20000, 0.0, 2), o);
+  EXPECT_TRUE(r.measures.watertight);
+  EXPECT_EQ(r.measures.components, 1u);
+  EXPECT_EQ(r.measures.genus, 1.0);
+  const SurfaceDistance d = accuracy(r, *knot);
+  EXPECT_LT(d.chamfer, 0.15) << d.chamfer;
+}
+
+TEST(Reconstruction, NoisySphereStaysWithinTheNoise) {
+  const auto sphere = make_sphere({0, 0, 0}, 1.0);
+  ReconstructionOptions o;
+  o.resolution = 64;
+  o.neighbors = 16;
+  const double h = 2.0 / (64 - 2 * (3 + 2));
+  const double sigma = 0.5 * h;  // half a voxel of Gaussian noise
+  const ReconstructionResult r = reconstruct_surface(samples(*sphere, 8000, sigma, 3), o);
+  EXPECT_TRUE(r.measures.watertight);
+  EXPECT_EQ(r.measures.genus, 0.0);
+  const SurfaceDistance d = accuracy(r, *sphere);
+  // Averaging 16 points divides the noise by 4: well under the noise's own mean |e| (0.4 voxel).
+  EXPECT_LT(d.chamfer, 0.25) << d.chamfer;
+}
+
+TEST(Reconstruction, BadInputsGiveTypedErrors) {
+  auto code = [](const std::vector<Vec3d>& pts, const ReconstructionOptions& o) {
+    try {
+      reconstruct_surface(pts, o);
+    } catch (const Error& e) {
+      return e.code();
+    }
+    return ErrorCode::Corrupt;  // not thrown
+  };
+  const ReconstructionOptions o;
+  const std::vector<Vec3d> four = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
+  EXPECT_EQ(code({}, o), ErrorCode::InvalidArgument);
+  EXPECT_EQ(code({{1, 2, 3}}, o), ErrorCode::InvalidArgument);
+  EXPECT_EQ(code({{1, 2, 3}, {1, 2, 3}, {1, 2, 3}, {1, 2, 3}}, o), ErrorCode::InvalidArgument);
+  std::vector<Vec3d> nan = four;
+  nan[2].y = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_EQ(code(nan, o), ErrorCode::NonFinite);
+  ReconstructionOptions huge;
+  huge.resolution = 0;
+  huge.voxel_size = 1e-9;
+  EXPECT_EQ(code(four, huge), ErrorCode::LimitExceeded);
+  ReconstructionOptions tiny;
+  tiny.resolution = 5;
+  EXPECT_EQ(code(four, tiny), ErrorCode::InvalidArgument);
+  ReconstructionOptions both;
+  both.voxel_size = 0.1;
+  EXPECT_EQ(code(four, both), ErrorCode::InvalidArgument);
+  ReconstructionOptions k;
+  k.neighbors = 0;
+  EXPECT_EQ(code(four, k), ErrorCode::InvalidArgument);
+  ReconstructionOptions passes;
+  passes.snap_passes = 17;
+  EXPECT_EQ(code(four, passes), ErrorCode::InvalidArgument);
+}
+
+}  // namespace
+}  // namespace levelset::apps
