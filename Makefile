@@ -17,12 +17,10 @@ configure: deps
 build: configure
 	@cmake --build $(BUILD) -j $(JOBS)
 
-# Main job on an embedded default: built-in torus knot -> narrow band -> .lsg -> info.
+# Main job on an embedded default: the surface reconstruction from 20000 points sampled on
+# the built-in torus knot (no external files); prints the progress and where the outputs went.
 run: build
-	@mkdir -p $(OUT)
-	@$(BUILD)/server/levelsetd primitive knot --resolution 256 --band 3 -o $(OUT)/knot.lsg
-	@$(BUILD)/server/levelsetd info $(OUT)/knot.lsg
-	@echo "outputs: $(abspath $(OUT))/knot.lsg"
+	@$(BUILD)/server/levelsetd run configs/jobs/reconstruct_knot.conf -o $(OUT)
 
 test: build
 	@cd $(BUILD) && ctest --output-on-failure -j $(JOBS)

@@ -22,6 +22,7 @@ struct ApplicationEntry {
 // All applications, in the order the README lists them.
 const std::vector<ApplicationEntry>& applications();
 
+void run_reconstruct_job(JobContext& context);
 void run_evolve_job(JobContext& context);
 void run_offset_job(JobContext& context);
 void run_fair_job(JobContext& context);

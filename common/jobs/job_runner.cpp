@@ -16,6 +16,7 @@ namespace fs = std::filesystem;
 
 const std::vector<ApplicationEntry>& applications() {
   static const std::vector<ApplicationEntry> list = {
+      {"reconstruct", run_reconstruct_job, "watertight surface from unorganised points (thesis 5.1.3)"},
       {"evolve", run_evolve_job, "move the input surface with a speed formula (thesis 4.7)"},
       {"offset", run_offset_job, "offset surfaces, and +D then -D (thesis 5.1.1)"},
       {"fair", run_fair_job, "fairing by curvature flows (thesis 3.1, 5.1.2)"},

@@ -3,6 +3,9 @@
 
 #include <nlohmann/json.hpp>
 
+#include <vector>
+
+#include "apps/reconstruction.hpp"
 #include "apps/shape_measures.hpp"
 #include "surface/mesh_measures.hpp"
 
@@ -12,5 +15,7 @@ namespace levelset::jobs {
 nlohmann::json measures_json(const MeshMeasures& m);
 // The shape measures: size, topology, sphere fit and mean-curvature statistics.
 nlohmann::json shape_json(const apps::ShapeMeasures& m);
+// The reconstruction's levels: voxel size, steps, convergence, voxels, seconds per phase.
+nlohmann::json stages_json(const std::vector<apps::ReconstructionStage>& stages);
 
 }  // namespace levelset::jobs

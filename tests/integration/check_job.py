@@ -151,7 +151,24 @@ def check_voronoi_seeds(run):
     assert err < 0.5 * h, ("travel time vs distance to the nearest seed", err, h)
 
 
+def check_reconstruct_knot(run):
+    base = ["--set", "raster.resolution=128", "--set", "reconstruct.accuracy_samples=20000"]
+    # Clean points: watertight, the knot's genus, sub-voxel accurate against the true surface.
+    s = run(base)
+    mesh_ok(s["mesh"], genus=1, components=1)
+    a = s["accuracy"]
+    assert a["chamfer_voxels"] < 0.15 and a["hausdorff_voxels"] < 1.5, a
+    assert s["reconstruct"]["points"] == 20000 and len(s["reconstruct"]["levels"]) >= 2, s["reconstruct"]
+    # Noise of 0.2% of the diagonal: still the right topology, and closer to the truth than
+    # the points themselves are (mean |noise| = 0.8 sigma).
+    s = run(base + ["--set", "input.noise=0.002", "--set", "reconstruct.neighbors=24"])
+    mesh_ok(s["mesh"], genus=1, components=1)
+    sigma = 0.002 * s["accuracy"]["diagonal"]
+    assert s["accuracy"]["chamfer"] < 0.5 * sigma, (s["accuracy"], sigma)
+
+
 CHECKS = {
+    "reconstruct_knot": check_reconstruct_knot,
     "path_sphere": check_path_sphere,
     "voronoi_seeds": check_voronoi_seeds,
     "evolve_dumbbell": check_evolve_dumbbell,

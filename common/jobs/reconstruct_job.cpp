@@ -1,0 +1,112 @@
+// job = reconstruct: a watertight surface through unorganised points (apps/reconstruction,
+// thesis 5.1.3). The points come from a file, or are sampled (by area, seeded, optionally
+// with Gaussian noise) on a built-in shape or a mesh; then the true surface is known and
+// the stats hold the accuracy: symmetric mean (Chamfer) and Hausdorff distances between the
+// result and the truth, in world units, voxels and bounding-box diagonals.
+//   input { points = FILE (.xyz .xyzn .pwn .ply)  |  sample = knot  |  sample_mesh = FILE
+//           count = 20000  noise = 0 (x the bbox diagonal)  seed = 1 }
+//   reconstruct { levels = 3  neighbors = 8  curvature_weight = 0.3  max_steps = 120
+//                 snap_passes = 1  tolerance = 0.01  shell_offset = 2  accuracy_samples = 100000 }
+// The raster's resolution / voxel_size / band are the final level's.
+#include <functional>
+#include <memory>
+
+#include "apps/mesh_distance.hpp"
+#include "apps/reconstruction.hpp"
+#include "apps/sample_points.hpp"
+#include "core/error.hpp"
+#include "geometry/analytic_shapes.hpp"
+#include "io/mesh_reader.hpp"
+#include "io/point_cloud_reader.hpp"
+#include "jobs/applications.hpp"
+
+namespace levelset::jobs {
+
+void run_reconstruct_job(JobContext& ctx) {
+  const config::Set& in = ctx.section("input", {"points", "sample", "sample_mesh", "count", "noise", "seed"});
+  const config::Set& s = ctx.section("reconstruct", {"levels", "neighbors", "curvature_weight", "max_steps", "snap_passes",
+                                                     "tolerance", "shell_offset", "accuracy_samples"});
+  const int given = (ctx.has(in, "points") ? 1 : 0) + (ctx.has(in, "sample") ? 1 : 0) + (ctx.has(in, "sample_mesh") ? 1 : 0);
+  if (given != 1)
+    throw Error(ErrorCode::InvalidArgument, ctx.options().name,
+                "the input set needs exactly one of points = FILE, sample = SHAPE, sample_mesh = FILE");
+
+  // The points, and the true surface when they were sampled from one.
+  std::vector<Vec3d> points;
+  std::unique_ptr<AnalyticShape> shape;
+  TriangleMesh truth_mesh;
+  std::function<double(const Vec3d&)> truth_distance;
+  std::unique_ptr<apps::MeshDistance> truth_mesh_distance;
+  apps::SurfaceSampleOptions sampling;
+  sampling.count = static_cast<std::size_t>(ctx.integer(in, "count", 20000, 4, 1 << 26));
+  sampling.seed = static_cast<std::uint64_t>(ctx.integer(in, "seed", 1, 0, 1 << 30));
+  const double noise = ctx.number(in, "noise", 0.0, 0.0, 0.1);
+  if (ctx.has(in, "points")) {
+    const std::string path = ctx.input_path(in, "points");
+    points = read_point_cloud(path).cloud.points;
+    ctx.log("input: " + std::to_string(points.size()) + " points from " + path);
+  } else if (ctx.has(in, "sample")) {
+    shape = make_builtin_shape(ctx.word(in, "sample", "", builtin_shape_names()));
+    sampling.noise = noise * length(shape->bounds().extent());
+    points = apps::sample_shape_surface(*shape, sampling);
+    truth_distance = [&](const Vec3d& p) { return std::abs(shape->distance(p)); };
+    ctx.log("input: " + std::to_string(points.size()) + " points sampled on the built-in " + shape->name());
+  } else {
+    const std::string path = ctx.input_path(in, "sample_mesh");
+    truth_mesh = read_mesh(path).mesh;
+    sampling.noise = noise * length(truth_mesh.bounds().extent());
+    points = apps::sample_mesh_surface(truth_mesh, sampling);
+    truth_mesh_distance = std::make_unique<apps::MeshDistance>(truth_mesh);
+    truth_distance = [&](const Vec3d& p) { return truth_mesh_distance->distance(p); };
+    ctx.log("input: " + std::to_string(points.size()) + " points sampled on " + path);
+  }
+
+  apps::ReconstructionOptions o;
+  const JobContext::Raster r = ctx.raster(256, 3);
+  o.resolution = r.voxel_size > 0 ? 0 : r.resolution;
+  o.voxel_size = r.voxel_size;
+  o.half_width = r.band;
+  o.levels = ctx.integer(s, "levels", o.levels, 1, 6);
+  o.neighbors = ctx.integer(s, "neighbors", o.neighbors, 1, 256);
+  o.curvature_weight = ctx.number(s, "curvature_weight", o.curvature_weight, 0.0, 100.0);
+  o.max_steps = ctx.integer(s, "max_steps", o.max_steps, 1, 100000);
+  o.snap_passes = ctx.integer(s, "snap_passes", o.snap_passes, 0, 16);
+  o.tolerance = ctx.number(s, "tolerance", o.tolerance, 1e-9, 10.0);
+  o.shell_offset = ctx.number(s, "shell_offset", o.shell_offset, 1.0, 16.0);
+  o.progress = ctx.options().progress;
+  o.log = [&ctx](const std::string& line) { ctx.log(line); };
+  const apps::ReconstructionResult result = apps::reconstruct_surface(points, o);
+  ctx.stats()["reconstruct"] = {{"points", points.size()},     {"voxel_size", result.voxel_size},
+                                {"steps", result.steps},       {"seconds", result.seconds},
+                                {"levels", stages_json(result.stages)}};
+  ctx.stats()["mesh"] = measures_json(result.measures);
+
+  if (truth_distance) {
+    // Accuracy against the true surface, from dense samples of both.
+    apps::SurfaceSampleOptions dense;
+    dense.count = static_cast<std::size_t>(ctx.integer(s, "accuracy_samples", 100000, 1000, 1 << 24));
+    dense.seed = 12345;
+    const std::vector<Vec3d> ours = apps::sample_mesh_surface(result.mesh, dense);
+    const std::vector<Vec3d> truth = shape ? apps::sample_shape_surface(*shape, dense) : apps::sample_mesh_surface(truth_mesh, dense);
+    const apps::MeshDistance ours_distance(result.mesh);
+    const apps::SurfaceDistance d =
+        apps::surface_distance(ours, truth_distance, truth, [&](const Vec3d& p) { return ours_distance.distance(p); });
+    const BBox box = shape ? shape->bounds() : truth_mesh.bounds();
+    const double diagonal = length(box.extent());
+    ctx.stats()["accuracy"] = {{"chamfer", d.chamfer},
+                               {"hausdorff", d.hausdorff},
+                               {"chamfer_voxels", d.chamfer / result.voxel_size},
+                               {"hausdorff_voxels", d.hausdorff / result.voxel_size},
+                               {"chamfer_diagonals", d.chamfer / diagonal},
+                               {"diagonal", diagonal},
+                               {"samples", dense.count}};
+    char line[200];
+    std::snprintf(line, sizeof line, "accuracy: Chamfer %.3g voxel (%.3g of the diagonal), Hausdorff %.3g voxel",
+                  d.chamfer / result.voxel_size, d.chamfer / diagonal, d.hausdorff / result.voxel_size);
+    ctx.log(line);
+  }
+  ctx.write_band(result.band);
+  ctx.write_mesh(result.mesh);
+}
+
+}  // namespace levelset::jobs
