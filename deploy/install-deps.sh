@@ -10,7 +10,7 @@ PACKAGES=(
   # libFuzzer runs (make fuzz): clang with its fuzzer/sanitizer runtimes
   clang-14 libclang-rt-14-dev
   # core library
-  libtbb-dev libzstd-dev libxxhash-dev
+  libtbb-dev libzstd-dev libxxhash-dev zlib1g-dev
   # command line
   libcli11-dev nlohmann-json3-dev libfmt-dev
   # mesh I/O reference and later mesh work

@@ -16,6 +16,7 @@ Command add_csg_command(CLI::App& app, int& threads);
 Command add_path_command(CLI::App& app, int& threads);
 Command add_voronoi_command(CLI::App& app, int& threads);
 Command add_reconstruct_command(CLI::App& app, int& threads);
+Command add_segment_command(CLI::App& app, int& threads);
 
 std::vector<Command> registered_commands(CLI::App& app, int& threads) {
   std::vector<Command> commands;
@@ -27,6 +28,7 @@ std::vector<Command> registered_commands(CLI::App& app, int& threads) {
   commands.push_back(add_path_command(app, threads));
   commands.push_back(add_voronoi_command(app, threads));
   commands.push_back(add_reconstruct_command(app, threads));
+  commands.push_back(add_segment_command(app, threads));
   return commands;
 }
 
