@@ -24,7 +24,8 @@
 //                     in the decompressed stream for gzip data)
 //   LimitExceeded     voxels above max_voxels, samples above max_sample_bytes, a header
 //                     longer than 1 MiB, a file above max_file_bytes
-//   NonFinite         NaN/Inf spacing, origin or float sample; where = line or byte
+//   NonFinite         NaN/Inf spacing, origin or float sample (Inf samples pass with
+//                     allow_infinite); where = line or byte
 //   UnsupportedFormat unknown magic, type, encoding, CPU; VDIM > 1; rotated or flipped axes;
 //                     detached data from memory
 //   Corrupt           broken gzip stream
@@ -54,6 +55,7 @@ struct ImageReadOptions {
   std::uint64_t max_file_bytes = std::uint64_t{1} << 34;     // compressed / on-disk bytes
   std::uint64_t max_voxels = std::uint64_t{1} << 31;
   std::uint64_t max_sample_bytes = std::uint64_t{1} << 33;   // 4 bytes per voxel in memory
+  bool allow_infinite = false;  // +-Inf float samples (cost grids: +Inf = blocked); NaN never
   ProgressHook progress;
 };
 

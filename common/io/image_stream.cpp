@@ -172,10 +172,11 @@ float decode(const unsigned char* p, SampleType type, bool swap) {
     case SampleType::Float32: return load<float>(p, swap);
     case SampleType::Float64: {
       const double d = load<double>(p, swap);
-      // Beyond float's range becomes Inf and is refused below, as NaN and Inf are.
-      return std::isfinite(d) && std::fabs(d) <= double(std::numeric_limits<float>::max())
+      // NaN stays NaN; beyond float's range becomes +-Inf (refused below unless allowed).
+      if (std::isnan(d)) return std::numeric_limits<float>::quiet_NaN();
+      return std::fabs(d) <= double(std::numeric_limits<float>::max())
                  ? float(d)
-                 : std::numeric_limits<float>::infinity();
+                 : std::copysign(std::numeric_limits<float>::infinity(), float(d));
     }
   }
   return 0.0f;
@@ -203,7 +204,7 @@ void read_samples(ByteStream& stream, const SampleLayout& layout, std::uint64_t 
     const std::size_t whole = got / size;
     for (std::size_t s = 0; s < whole; ++s) {
       const float v = decode(buffer.data() + s * size, layout.type, swap);
-      if (floating && !std::isfinite(v))
+      if (floating && !std::isfinite(v) && (std::isnan(v) || !options.allow_infinite))
         throw Error(ErrorCode::NonFinite, at_byte(name, byte_base + (done + s) * size),
                     "sample " + std::to_string(done + s) + " is not a finite number");
       lo = std::min(lo, v);

@@ -7,7 +7,7 @@
 
 #include "core/error.hpp"
 #include "grid/lsg_file.hpp"
-#include "io/nrrd_file.hpp"
+#include "io/image_reader.hpp"
 
 namespace levelset::cli {
 
@@ -72,14 +72,20 @@ Medium load_medium(const MediumArgs& a, const std::vector<Vec3d>& points) {
   if (!a.cost_grid.empty()) {
     if (!a.bounds.empty() || a.resolution > 0 || a.voxel_size > 0)
       throw Error(ErrorCode::InvalidArgument, "--cost-grid", "the cost grid fixes the grid: drop --bounds/--resolution/--voxel-size");
-    NrrdVolume vol = load_nrrd(a.cost_grid, apps::kDefaultMaxGridVoxels);
-    m.grid.nx = vol.frame.sizes[0];
-    m.grid.ny = vol.frame.sizes[1];
-    m.grid.nz = vol.frame.sizes[2];
-    m.grid.voxel_size = vol.frame.spacing;
-    m.grid.origin = vol.frame.origin;
+    ImageReadOptions read_options;
+    read_options.max_voxels = apps::kDefaultMaxGridVoxels;
+    read_options.allow_infinite = true;  // +Inf = blocked
+    ImageReadResult vol = read_image(a.cost_grid, read_options);
+    const ImageVolume& img = vol.image;
+    if (img.spacing.x != img.spacing.y || img.spacing.x != img.spacing.z)
+      throw Error(ErrorCode::UnsupportedFormat, a.cost_grid, "a cost grid needs cubic voxels (equal spacings)");
+    m.grid.nx = static_cast<int>(img.nx);
+    m.grid.ny = static_cast<int>(img.ny);
+    m.grid.nz = static_cast<int>(img.nz);
+    m.grid.voxel_size = img.spacing.x;
+    m.grid.origin = img.origin;
     apps::validate_grid(m.grid, apps::kDefaultMaxGridVoxels, a.cost_grid);
-    m.cost.values = std::move(vol.samples);
+    m.cost.values.assign(img.samples.begin(), img.samples.end());
   } else {
     BBox box;
     if (!a.bounds.empty()) {
