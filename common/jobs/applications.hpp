@@ -28,6 +28,7 @@ void run_offset_job(JobContext& context);
 void run_fair_job(JobContext& context);
 void run_minmax_job(JobContext& context);
 void run_csg_job(JobContext& context);
+void run_segment_job(JobContext& context);
 void run_path_job(JobContext& context);
 void run_voronoi_job(JobContext& context);
 

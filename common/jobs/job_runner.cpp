@@ -22,6 +22,7 @@ const std::vector<ApplicationEntry>& applications() {
       {"fair", run_fair_job, "fairing by curvature flows (thesis 3.1, 5.1.2)"},
       {"minmax", run_minmax_job, "feature-preserving min/max flow to a steady state (thesis 3.3)"},
       {"csg", run_csg_job, "union, intersection, difference of two level sets (thesis 3.5, 5.1.4)"},
+      {"segment", run_segment_job, "shape detection in a 3D image by an edge-stopped front (thesis 3.4)"},
       {"path", run_path_job, "shortest path by fast marching around obstacles (thesis 3.6)"},
       {"voronoi", run_voronoi_job, "geodesic Voronoi regions of seeds by fast marching (thesis 3.5)"},
   };

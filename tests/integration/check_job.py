@@ -167,7 +167,16 @@ def check_reconstruct_knot(run):
     assert s["accuracy"]["chamfer"] < 0.5 * sigma, (s["accuracy"], sigma)
 
 
+def check_segment_liver(run):
+    # The whole liver (downsampled 4x) against the threshold component that holds the seeds.
+    s = run([])
+    g = s["segment"]
+    assert g["converged"] and g["dice_vs_threshold"] >= 0.95, g
+    mesh_ok(s["mesh"], components=1)
+
+
 CHECKS = {
+    "segment_liver": check_segment_liver,
     "reconstruct_knot": check_reconstruct_knot,
     "path_sphere": check_path_sphere,
     "voronoi_seeds": check_voronoi_seeds,

@@ -10,6 +10,7 @@
 
 #include "apps/edge_indicator.hpp"
 #include "apps/gaussian_smooth.hpp"
+#include "apps/image_regions.hpp"
 #include "apps/segmentation.hpp"
 #include "core/error.hpp"
 #include "io/image_reader.hpp"
@@ -128,46 +129,12 @@ TEST(Segmentation, OptionErrors) {
 }
 
 // Block average of factor f (the block's centre becomes the voxel), keeping z slices < max_z.
+// The lower max_z slices of the image downsampled by f (apps/image_regions.hpp).
 ImageVolume downsample(const ImageVolume& im, int f, std::int64_t max_z) {
-  ImageVolume out;
-  out.nx = im.nx / f;
-  out.ny = im.ny / f;
-  out.nz = std::min(im.nz / f, max_z);
-  out.spacing = im.spacing * double(f);
-  out.origin = im.origin + im.spacing * (0.5 * (f - 1));
-  out.samples.assign(out.voxel_count(), 0.0f);
-  for (std::int64_t k = 0; k < out.nz * f; ++k)
-    for (std::int64_t j = 0; j < out.ny * f; ++j)
-      for (std::int64_t i = 0; i < out.nx * f; ++i)
-        out.samples[out.index(i / f, j / f, k / f)] += im.at(i, j, k) / float(f * f * f);
+  ImageVolume out = downsample_image(im, f);
+  out.nz = std::min(out.nz, max_z);
+  out.samples.resize(out.voxel_count());
   return out;
-}
-
-// The 6-connected components of {I > t} that contain the seed voxels.
-std::vector<std::uint8_t> threshold_components(const ImageVolume& im, float t, const std::vector<std::size_t>& seeds) {
-  std::vector<std::uint8_t> in(im.voxel_count(), 0);
-  std::vector<std::size_t> stack;
-  for (const std::size_t s : seeds) {
-    in[s] = 1;
-    stack.push_back(s);
-  }
-  const std::int64_t step[3] = {1, im.nx, im.nx * im.ny};
-  const std::int64_t n[3] = {im.nx, im.ny, im.nz};
-  while (!stack.empty()) {
-    const std::size_t v = stack.back();
-    stack.pop_back();
-    const std::int64_t c[3] = {std::int64_t(v) % im.nx, (std::int64_t(v) / im.nx) % im.ny, std::int64_t(v) / (im.nx * im.ny)};
-    for (int a = 0; a < 3; ++a)
-      for (int d : {-1, 1}) {
-        if (c[a] + d < 0 || c[a] + d >= n[a]) continue;
-        const std::size_t w = std::size_t(std::int64_t(v) + d * step[a]);
-        if (!in[w] && im.samples[w] > t) {
-          in[w] = 1;
-          stack.push_back(w);
-        }
-      }
-  }
-  return in;
 }
 
 // Acceptance (thesis 3.4 on real data): CGAL's liver.inr.gz is a label image (0 background, 127
@@ -185,36 +152,24 @@ TEST(Segmentation, LiverMatchesThresholdComponent) {
   const ImageVolume im = downsample(read_image(file).image, 4, 24);
   const float t = 127.5f;
   SegmentationOptions o;
-  std::vector<std::size_t> seed_voxels;
-  for (std::int64_t k = 3; k + 3 < im.nz; ++k)
-    for (std::int64_t j = 3; j + 3 < im.ny; ++j)
-      for (std::int64_t i = 3; i + 3 < im.nx; ++i) {
-        if (i % 6 != 0 || j % 6 != 0 || k % 3 != 0) continue;
-        bool all = true;
-        for (int dz = -3; dz <= 3 && all; ++dz)
-          for (int dy = -3; dy <= 3 && all; ++dy)
-            for (int dx = -3; dx <= 3 && all; ++dx) all = im.at(i + dx, j + dy, k + dz) > t;
-        if (!all) continue;
-        seed_voxels.push_back(im.index(i, j, k));
-        o.seeds.push_back({im.world(i, j, k), 2.5 * im.spacing.x});
-      }
+  const std::vector<std::size_t> seed_voxels = seed_voxels_above(im, t, 6, 3);
+  for (const std::size_t v : seed_voxels)
+    o.seeds.push_back({im.world(std::int64_t(v) % im.nx, (std::int64_t(v) / im.nx) % im.ny, std::int64_t(v) / (im.nx * im.ny)),
+                       2.5 * im.spacing.x});
   ASSERT_GE(seed_voxels.size(), 10u);
-  const std::vector<std::uint8_t> reference = threshold_components(im, t, seed_voxels);
+  const std::vector<std::uint8_t> reference = threshold_component(im, t, seed_voxels);
   o.label_mask = true;
   o.motion_tolerance = 0.05;
   const SegmentationResult r = segment_image(im, o);
-  std::uint64_t both = 0, ref = 0;
-  for (std::size_t v = 0; v < reference.size(); ++v) {
-    both += reference[v] & r.label_mask[v];
-    ref += reference[v];
-  }
-  const double dice = 2.0 * double(both) / double(ref + r.inside_voxels);
-  EXPECT_GE(dice, 0.95) << "reference " << ref << " voxels, segmented " << r.inside_voxels << ", " << r.steps
+  const double dice_value = dice(reference, r.label_mask);
+  std::uint64_t ref = 0;
+  for (const std::uint8_t v : reference) ref += v;
+  EXPECT_GE(dice_value, 0.95) << "reference " << ref << " voxels, segmented " << r.inside_voxels << ", " << r.steps
                         << " steps, converged " << r.converged;
   EXPECT_TRUE(r.converged);
   EXPECT_TRUE(r.measures.watertight);
   EXPECT_EQ(r.measures.components, 1u);
-  std::printf("liver: Dice %.4f, %zu seeds, %llu reference voxels, %llu segmented, %d steps, t = %.1f, %.2f s\n", dice,
+  std::printf("liver: Dice %.4f, %zu seeds, %llu reference voxels, %llu segmented, %d steps, t = %.1f, %.2f s\n", dice_value,
               seed_voxels.size(), (unsigned long long)ref, (unsigned long long)r.inside_voxels, r.steps, r.time,
               r.seconds_total);
 }
