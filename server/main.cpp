@@ -23,8 +23,8 @@ int main(int argc, char** argv) {
   int threads = 0;
 
   levelset::cli::InfoArgs info;
-  CLI::App* info_cmd = app.add_subcommand("info", "Print what a mesh, point cloud or .lsg file holds");
-  info_cmd->add_option("file", info.path, "Input file (.lsg .off .tria .ply .obj .stl .xyz .xyzn .pwn)")
+  CLI::App* info_cmd = app.add_subcommand("info", "Print what a mesh, point cloud, 3D image or .lsg file holds");
+  info_cmd->add_option("file", info.path, "Input file (.lsg .off .tria .ply .obj .stl .xyz .xyzn .pwn .inr .inr.gz .nrrd .nhdr)")
       ->required();
   info_cmd->add_flag("--json", info.json, "Print JSON instead of text");
 

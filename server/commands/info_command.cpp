@@ -1,4 +1,4 @@
-// levelsetd info FILE [--json]: what a mesh, point cloud or .lsg file holds.
+// levelsetd info FILE [--json]: what a mesh, point cloud, 3D image or .lsg file holds.
 #include <algorithm>
 #include <cctype>
 #include <cstdio>
@@ -12,6 +12,7 @@
 #include "core/error.hpp"
 #include "grid/lsg_file.hpp"
 #include "io/mesh_reader.hpp"
+#include "io/image_reader.hpp"
 #include "io/point_cloud_reader.hpp"
 
 namespace levelset::cli {
@@ -84,6 +85,24 @@ json cloud_info(const std::string& path) {
   return j;
 }
 
+json image_info(const std::string& path) {
+  ImageReadOptions options;
+  options.allow_infinite = true;  // cost grids and travel times hold +Inf
+  const ImageReadResult r = read_image(path, options);
+  const ImageVolume& im = r.image;
+  json j;
+  j["kind"] = "image";
+  j["format"] = std::string(to_string(r.format));
+  j["sample_type"] = r.sample_type;
+  j["gzip"] = r.gzip;
+  j["dims"] = {im.nx, im.ny, im.nz};
+  j["spacing"] = {im.spacing.x, im.spacing.y, im.spacing.z};
+  j["origin"] = {im.origin.x, im.origin.y, im.origin.z};
+  j["range"] = {r.min_sample, r.max_sample};
+  j["world_bounds"] = bbox_json(im.bounds());
+  return j;
+}
+
 void print_human(const std::string& path, const json& j) {
   auto vec = [](const json& v) {
     char buf[128];
@@ -110,6 +129,14 @@ void print_human(const std::string& path, const json& j) {
     std::printf("vertices:        %llu\n", j["vertices"].get<unsigned long long>());
     std::printf("triangles:       %llu (from %llu faces)\n", j["triangles"].get<unsigned long long>(),
                 j["source_faces"].get<unsigned long long>());
+  } else if (kind == "image") {
+    std::printf("kind:            3D image (%s%s, %s samples)\n", j["format"].get<std::string>().c_str(),
+                j["gzip"].get<bool>() ? ", gzip" : "", j["sample_type"].get<std::string>().c_str());
+    std::printf("dims:            %lld x %lld x %lld\n", j["dims"][0].get<long long>(), j["dims"][1].get<long long>(),
+                j["dims"][2].get<long long>());
+    std::printf("spacing:         %s\n", vec(j["spacing"]).c_str());
+    std::printf("origin:          %s\n", vec(j["origin"]).c_str());
+    std::printf("range:           %.6g .. %.6g\n", j["range"][0].get<double>(), j["range"][1].get<double>());
   } else {
     std::printf("kind:            point cloud (%s)\n", j["format"].get<std::string>().c_str());
     std::printf("points:          %llu%s\n", j["points"].get<unsigned long long>(),
@@ -143,9 +170,11 @@ int run_info(const InfoArgs& args) {
     }
   } else if (ext == ".off" || ext == ".tria" || ext == ".obj" || ext == ".stl") {
     j = mesh_info(args.path);
+  } else if (ext == ".inr" || ext == ".nrrd" || ext == ".nhdr" || ext == ".gz") {
+    j = image_info(args.path);
   } else {
     throw Error(ErrorCode::UnsupportedFormat, args.path,
-                "unknown extension '" + ext + "' (known: .lsg .off .tria .ply .obj .stl .xyz .xyzn .pwn)");
+                "unknown extension '" + ext + "' (known: .lsg .off .tria .ply .obj .stl .xyz .xyzn .pwn .inr .inr.gz .nrrd .nhdr)");
   }
   j["file"] = args.path;
   if (args.json) {

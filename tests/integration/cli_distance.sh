@@ -137,4 +137,17 @@ expect_error "bad points" "parse_error" "$bin" sample "$dir/box.lsg" --points "$
 [ ! -e "$dir/x.lsg" ] && [ ! -e "$dir/x.ply" ] && [ ! -e "$dir/x.xyz" ] || fail "a failed command left an output file"
 pass
 
+# A 3D image: CGAL's skull (64^3 float INR with anisotropic voxels); a truncated copy fails.
+"$bin" info "$data/images/skull_2.9.inr" --json > "$dir/skull.json" || fail "info on an INR image"
+/usr/bin/python3 - "$dir/skull.json" <<'PY' || fail "skull image info"
+import json, sys
+j = json.load(open(sys.argv[1]))
+assert j["kind"] == "image" and j["format"] == "inr" and j["dims"] == [64, 64, 64], j
+assert abs(j["spacing"][0] - 3.94305) < 1e-5 and abs(j["spacing"][2] - 3.65079) < 1e-5, j
+assert 5 < j["range"][1] < 6, j
+PY
+head -c 100000 "$data/images/skull_2.9.inr" > "$dir/cut.inr"
+expect_error "truncated image" "truncated" "$bin" info "$dir/cut.inr"
+pass
+
 echo "cli_distance: $checks checks passed"
