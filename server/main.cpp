@@ -163,6 +163,9 @@ int main(int argc, char** argv) {
   } catch (const std::bad_alloc&) {
     std::fprintf(stderr, "levelsetd: out of memory\n");
     return 1;
+  } catch (const std::exception& e) {  // not ours (a library's): still one line and exit 1
+    std::fprintf(stderr, "levelsetd: internal error: %s\n", e.what());
+    return 1;
   }
   return 2;
 }

@@ -31,7 +31,7 @@ std::pair<double, double> robust_range(const std::vector<float>& s, double lo, d
     a = *std::min_element(s.begin(), s.end());
     b = *std::max_element(s.begin(), s.end());
   }
-  return {a, b > a ? b : a + 1};
+  return {a, b > a ? b : a + std::max(1.0, std::abs(a))};  // a + 1 == a for |a| >= 2^53
 }
 
 // Central differences (one-sided at the border) of `f` at voxel (i,j,k), world units.

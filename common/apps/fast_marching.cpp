@@ -225,6 +225,8 @@ class Marcher {
 };
 
 void validate_options(const FastMarchingOptions& o) {
+  if (o.max_voxels > std::uint64_t(std::numeric_limits<std::int32_t>::max()))
+    throw Error(ErrorCode::InvalidArgument, "fast_marching max_voxels", "at most 2^31 - 1 nodes (32-bit heap indices)");
   validate_grid(o.grid, o.max_voxels, "fast_marching grid");
   if (o.order != 1 && o.order != 2)
     throw Error(ErrorCode::InvalidArgument, "fast_marching order", "must be 1 or 2");

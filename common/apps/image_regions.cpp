@@ -47,6 +47,7 @@ std::vector<std::uint8_t> threshold_component(const ImageVolume& im, float t, co
   std::vector<std::uint8_t> in(im.voxel_count(), 0);
   std::vector<std::size_t> stack;
   for (const std::size_t s : seeds) {
+    if (s >= in.size() || !(im.samples[s] > t)) continue;  // a seed below t starts no component
     in[s] = 1;
     stack.push_back(s);
   }

@@ -6,7 +6,7 @@
 //     along z) whose (2r+1)^3 neighbourhood lies entirely above t: seeds a user would click
 //     well inside bright structures. Returns voxel indices (x fastest).
 //   threshold_component: the 6-connected components of {I > t} that contain the seed voxels
-//     (a seed below t is included by itself), as a 0/1 mask.
+//     (a seed at or below t starts none), as a 0/1 mask.
 //   dice: 2 |A and B| / (|A| + |B|) of two 0/1 masks of equal size (1 when both are empty).
 // Cost: O(voxels). Threading: serial (downsample_image: TBB over slices).
 #pragma once

@@ -87,7 +87,7 @@ struct SegmentationOptions {
   double drift_tolerance = 0.2;   // ... and when the mean ||grad u| - 1| near the front exceeds this
   evolve::Scheme scheme = evolve::Scheme::Upwind1;
   int rk_order = 1;
-  std::uint64_t max_grid_voxels = std::uint64_t{1} << 31;  // grid voxels in the image box
+  std::uint64_t max_grid_voxels = std::uint64_t{1} << 28;  // grid voxels in the image box (~6 floats each)
   bool label_mask = false;        // fill SegmentationResult::label_mask
   std::function<void(const SegmentationCheck&)> on_check;
   ProgressHook progress;          // fraction of max_time (or steps / time); cancellable

@@ -57,8 +57,13 @@ ImageReadResult read_image(const std::filesystem::path& path, const ImageReadOpt
   const std::string bytes = read_file_bytes(path, options.max_file_bytes);
   const std::filesystem::path folder = path.parent_path();
   const detail::DataFileLoader loader = [&](const std::string& file) {
-    const std::filesystem::path p = std::filesystem::path(file).is_absolute() ? std::filesystem::path(file) : folder / file;
-    return read_file_bytes(p, options.max_file_bytes);
+    // The data file lies beside the header: a relative name without '..', so a header
+    // cannot make the reader disclose files elsewhere.
+    const std::filesystem::path f(file);
+    if (f.has_root_path() || file.find("..") != std::string::npos)
+      throw Error(ErrorCode::UnsupportedFormat, path.string(),
+                  "detached data file '" + file + "' must be a relative name in the header's folder, without '..'");
+    return read_file_bytes(folder / f, options.max_file_bytes);
   };
   return read_any(bytes, path.string(), options, loader);
 }

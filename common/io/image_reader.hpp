@@ -53,8 +53,8 @@ std::string_view to_string(ImageFormat format);  // "inr", "nrrd"
 
 struct ImageReadOptions {
   std::uint64_t max_file_bytes = std::uint64_t{1} << 34;     // compressed / on-disk bytes
-  std::uint64_t max_voxels = std::uint64_t{1} << 31;
-  std::uint64_t max_sample_bytes = std::uint64_t{1} << 33;   // 4 bytes per voxel in memory
+  std::uint64_t max_voxels = std::uint64_t{1} << 28;          // 1 GiB of float samples
+  std::uint64_t max_sample_bytes = std::uint64_t{1} << 30;   // 4 bytes per voxel in memory
   bool allow_infinite = false;  // +-Inf float samples (cost grids: +Inf = blocked); NaN never
   ProgressHook progress;
 };

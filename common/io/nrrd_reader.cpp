@@ -92,6 +92,7 @@ ImageReadResult read_nrrd(std::string_view bytes, std::string_view name, const I
     if (pos > kMaxHeader) throw Error(ErrorCode::LimitExceeded, at_line(name, line_no), "NRRD header longer than 1 MiB");
     std::size_t eol = bytes.find('\n', pos);
     if (eol == std::string_view::npos) eol = bytes.size();
+    if (eol - pos > kMaxHeader) throw Error(ErrorCode::LimitExceeded, at_line(name, line_no + 1), "NRRD header line longer than 1 MiB");
     std::string_view line = bytes.substr(pos, eol - pos);
     if (!line.empty() && line.back() == '\r') line.remove_suffix(1);
     pos = std::min(bytes.size(), eol + 1);

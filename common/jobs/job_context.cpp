@@ -151,11 +151,15 @@ std::string JobContext::input_path(const config::Set& set, std::string_view key)
   if (name.empty()) throw Error(ErrorCode::InvalidArgument, place(set, key), "empty file name");
   fs::path path;
   bool confined = options_.confine_inputs;
+  fs::path root = options_.base_dir;  // where a confined input must stay
   if (name.rfind("cgal:", 0) == 0) {
-    path = fs::path(cgal_data_dir()) / name.substr(5);
-    confined = false;  // the installed sample data is read-only and public
-    if (name.find("..") != std::string::npos)
-      throw Error(ErrorCode::InvalidArgument, place(set, key), "'..' is not allowed in cgal: names");
+    // The installed sample data is read-only and public: confined to its own directory.
+    const fs::path rest(name.substr(5));
+    if (rest.has_root_path() || name.find("..") != std::string::npos)
+      throw Error(ErrorCode::InvalidArgument, place(set, key), "cgal: names are relative, without '..'");
+    root = cgal_data_dir();
+    path = root / rest;
+    confined = true;
   } else {
     path = fs::path(name);
     if (path.is_relative()) path = fs::path(options_.base_dir) / path;
@@ -163,7 +167,7 @@ std::string JobContext::input_path(const config::Set& set, std::string_view key)
   std::error_code ec;
   const fs::path resolved = fs::weakly_canonical(path, ec);
   if (confined) {
-    const fs::path base = fs::weakly_canonical(options_.base_dir, ec);
+    const fs::path base = fs::weakly_canonical(root, ec);
     const auto rel = resolved.lexically_relative(base);
     if (ec || rel.empty() || *rel.begin() == "..")
       throw Error(ErrorCode::InvalidArgument, place(set, key), "'" + name + "' leaves the job's directory");
@@ -180,11 +184,11 @@ JobContext::Raster JobContext::raster(int fallback_resolution, double fallback_b
   if (has(r, "depth")) {
     if (has(r, "resolution"))
       throw Error(ErrorCode::InvalidArgument, place(r, "depth"), "give 'depth' or 'resolution', not both");
-    out.resolution = 1 << integer(r, "depth", 7, 3, 13);
+    out.resolution = 1 << integer(r, "depth", 7, 3, 12);
   }
-  out.resolution = integer(r, "resolution", out.resolution, 8, 8192);
+  out.resolution = integer(r, "resolution", out.resolution, 8, 4096);
   out.voxel_size = number(r, "voxel_size", 0.0, 0.0, 1e30);
-  out.band = number(r, "band", fallback_band, 1.0, 64.0);
+  out.band = number(r, "band", fallback_band, 1.0, 16.0);
   return out;
 }
 

@@ -76,7 +76,13 @@ JobResult run_job(const config::Set& job, const JobOptions& options_in) {
 
   JobContext context(job, options);
   context.log("job " + std::string(app->name) + ": " + std::string(app->summary));
-  app->run(context);
+  try {
+    app->run(context);
+  } catch (const Error& e) {
+    // An application's own place ("segment_image", "obstacle clearance") gets the job's name.
+    if (e.where().find(options_in.name) != std::string::npos || e.where().rfind("--set", 0) == 0) throw;
+    throw Error(e.code(), options_in.name + " (" + std::string(app->name) + ": " + e.where() + ")", e.reason());
+  }
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   context.log("done in " + std::to_string(seconds) + " s");
 
@@ -93,7 +99,7 @@ JobResult run_job(const config::Set& job, const JobOptions& options_in) {
   result.stats["seconds"]["total"] = seconds;
   result.stats["outputs"] = result.outputs;
   std::ofstream stats_file(stats_path, std::ios::trunc);
-  stats_file << result.stats.dump(2) << '\n';
+  stats_file << result.stats.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) << '\n';
   if (!stats_file) throw Error(ErrorCode::IoError, stats_path, "cannot write the stats");
   return result;
 }

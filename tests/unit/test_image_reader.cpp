@@ -190,7 +190,7 @@ TEST(ImageReader, GzipErrorsAndBombs) {
   EXPECT_LE(r.image.samples.capacity(), 8192u);
   // A small file claiming an image within the caps fails without allocating it.
   ImageReadOptions options;
-  const std::string claim = gzip(inr_header("XDIM=1024\nYDIM=1024\nZDIM=1024\nTYPE=unsigned fixed\nPIXSIZE=8 bits\n") + "abc");
+  const std::string claim = gzip(inr_header("XDIM=512\nYDIM=512\nZDIM=512\nTYPE=unsigned fixed\nPIXSIZE=8 bits\n") + "abc");
   EXPECT_TRUE(fails(claim, "claim.inr.gz", ErrorCode::Truncated, "claim.inr.gz @ byte 259", options));
 }
 

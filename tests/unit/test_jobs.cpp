@@ -9,6 +9,7 @@
 #include <functional>
 
 #include "core/error.hpp"
+#include "io/image_reader.hpp"
 #include "jobs/job.hpp"
 
 namespace levelset::jobs {
@@ -120,6 +121,10 @@ TEST(Jobs, ErrorsNameThePlaceAndTheReason) {
       {"job = evolve\ninput { mesh = missing.off }\n", {}, ErrorCode::IoError, "test.conf:2:9", "no such file"},
       {"job = evolve\ninput { mesh = \"cgal:../../etc/passwd\" }\n", {}, ErrorCode::InvalidArgument,
        "test.conf:2:9", "'..'"},
+      {"job = evolve\ninput { mesh = \"cgal:/etc/passwd\" }\n", {}, ErrorCode::InvalidArgument, "test.conf:2:9",
+       "cgal: names are relative"},
+      {"job = evolve\ninput { shape = sphere }\nraster { band = 64 }\n", {}, ErrorCode::InvalidArgument,
+       "test.conf:3:10", "outside"},
       {"job = evolve\ninput { shape = sphere }\nraster { resolution = 32 }\nevolve { speed = 1+ \n time = 1 }\n",
        {}, ErrorCode::ParseError, "test.conf:4:10 (formula:column 3)", "expected a value"},
       {"job = evolve\ninput { shape = sphere }\nraster { resolution = 32 }\nevolve { speed = 1\n }\n", {},
@@ -153,6 +158,24 @@ TEST(Jobs, ConfinedInputsCannotLeaveTheJobDirectory) {
                                              << " }\nevolve { speed = 1\n steps = 1 }\n";
   const Error e2 = error_of([&] { run_job_file((dir / "inner" / "abs.conf").string(), {}, options); });
   EXPECT_NE(e2.reason().find("leaves the job's directory"), std::string::npos) << e2.what();
+}
+
+TEST(Jobs, DetachedImageDataStaysBesideItsHeader) {
+  // A NRRD header must not make the reader open a file outside its folder.
+  const fs::path dir = scratch_dir();
+  fs::create_directories(dir / "inner");
+  std::ofstream(dir / "outside.raw", std::ios::binary) << std::string(8, '\0');
+  std::ofstream(dir / "inside.raw", std::ios::binary) << std::string(8, '\0');
+  const std::string head = "NRRD0004\ntype: uint8\ndimension: 3\nsizes: 2 2 2\nencoding: raw\ndata file: ";
+  for (const std::string& target : {std::string("../outside.raw"), (dir / "outside.raw").string()}) {
+    std::ofstream(dir / "inner" / "x.nhdr") << head << target << "\n\n";
+    const Error e = error_of([&] { read_image(dir / "inner" / "x.nhdr"); });
+    EXPECT_EQ(e.code(), ErrorCode::UnsupportedFormat) << target << ": " << e.what();
+    EXPECT_NE(e.reason().find("header's folder"), std::string::npos) << e.what();
+  }
+  fs::copy_file(dir / "inside.raw", dir / "inner" / "inside.raw");
+  std::ofstream(dir / "inner" / "x.nhdr") << head << "inside.raw\n\n";
+  EXPECT_EQ(read_image(dir / "inner" / "x.nhdr").image.voxel_count(), 8u);
 }
 
 }  // namespace levelset::jobs
