@@ -105,6 +105,9 @@ CostGrid build_cost_grid(const DenseGrid& grid, const CostField& field, const Ob
   }
 
   const double h = grid.voxel_size;
+  // The first bad cost of each slice (the error names the lowest one after the loop, so the
+  // message is the same for any thread count); -1: none.
+  std::vector<std::int64_t> first_bad(std::size_t(grid.nz), -1);
   for_each_slice(grid, progress, "cost", [&](int k) {
     // Per-slice scratch for the formula: world coordinates of up to 512 nodes of a row.
     formula::Workspace ws;
@@ -129,7 +132,8 @@ CostGrid build_cost_grid(const DenseGrid& grid, const CostField& field, const Ob
           for (int t = 0; t < m; ++t) row[i0 + t] = double(res[t]);
         }
       }
-      for (int i = 0; i < grid.nx; ++i) check_cost(row[i], grid.world(i, j, k));
+      for (int i = 0; i < grid.nx && first_bad[k] < 0; ++i)
+        if (!(row[i] > 0.0)) first_bad[k] = std::int64_t(grid.index(i, j, k));  // NaN or <= 0
       if (!obstacles.mask.empty())
         for (int i = 0; i < grid.nx; ++i)
           if (obstacles.mask[grid.index(i, j, k)]) row[i] = kInf;
@@ -142,6 +146,16 @@ CostGrid build_cost_grid(const DenseGrid& grid, const CostField& field, const Ob
             out.cost[grid.index(i, j, k)] = kInf;
     }
   });
+
+  for (int k = 0; k < grid.nz; ++k)
+    if (first_bad[k] >= 0) {
+      const std::int64_t v = first_bad[k];
+      const int i = int(v % grid.nx), j = int((v / grid.nx) % grid.ny);
+      // The raw value (obstacles may have overwritten it): recompute it the way the slice did.
+      const double c = field.values.empty() ? (out.pointwise ? out.pointwise(grid.world(i, j, k)) : field.uniform)
+                                            : field.values[std::size_t(v)];
+      check_cost(std::isnan(c) || !(c > 0.0) ? c : -0.0, grid.world(i, j, k));
+    }
 
   double lo = kInf, hi = 0.0;
   for (const double c : out.cost) {
