@@ -1,5 +1,6 @@
 #include "apps/point_distance.hpp"
 
+#include <algorithm>
 #include <array>
 #include <chrono>
 #include <cmath>
@@ -133,6 +134,58 @@ LocalFit local_fit(const PointIndex& index, const Vec3d& x, int k) {
   f.syy = float(s[3] * inv);
   f.syz = float(s[4] * inv);
   f.szz = float(s[5] * inv);
+  return f;
+}
+
+LocalFit one_sided_fit(const PointIndex& index, const Vec3d& x, const Vec3d& n, int k, double min_band) {
+  std::array<std::uint32_t, kMaxNeighbors> idx{};
+  std::array<double, kMaxNeighbors> d2{};
+  const int count = index.k_nearest(x, std::clamp(k, 1, kMaxNeighbors), idx.data(), d2.data());
+  LocalFit f;
+  if (count == 0) return f;
+  std::array<double, kMaxNeighbors> t{};
+  for (int i = 0; i < count; ++i) t[std::size_t(i)] = dot(x - index.points()[idx[std::size_t(i)]], n);
+  const int m = std::min(count, 8);
+  std::array<double, 8> near{};
+  for (int i = 0; i < m; ++i) near[std::size_t(i)] = t[std::size_t(i)];
+  auto median = [](std::array<double, 8> v, int size) {
+    for (int i = 1; i < size; ++i)  // insertion sort of at most 8 values
+      for (int j = i; j > 0 && v[std::size_t(j)] < v[std::size_t(j - 1)]; --j) std::swap(v[std::size_t(j)], v[std::size_t(j - 1)]);
+    return size % 2 == 1 ? v[std::size_t(size / 2)] : 0.5 * (v[std::size_t(size / 2 - 1)] + v[std::size_t(size / 2)]);
+  };
+  const double ref = median(near, m);
+  for (int i = 0; i < m; ++i) near[std::size_t(i)] = std::abs(near[std::size_t(i)] - ref);
+  // 1.4826: the MAD of a normal sample; 1.25: the MAD of 8 values about their own median
+  // is ~0.8 of the population's (measured on Gaussian samples of 8).
+  const double sigma = 1.25 * 1.4826 * median(near, m);
+  const double band = std::max(3.0 * sigma, min_band);
+  Vec3d a{};
+  double s[6] = {0, 0, 0, 0, 0, 0};
+  int used = 0;
+  for (int i = 0; i < count; ++i) {
+    if (std::abs(t[std::size_t(i)] - ref) > band) continue;
+    const Vec3d v = x - index.points()[idx[std::size_t(i)]];
+    a += v;
+    s[0] += v.x * v.x;
+    s[1] += v.x * v.y;
+    s[2] += v.x * v.z;
+    s[3] += v.y * v.y;
+    s[4] += v.y * v.z;
+    s[5] += v.z * v.z;
+    ++used;
+  }
+  const double inv = 1.0 / std::max(used, 1);
+  f.d = float(std::sqrt(d2[0]));
+  f.ax = float(a.x * inv);
+  f.ay = float(a.y * inv);
+  f.az = float(a.z * inv);
+  f.sxx = float(s[0] * inv);
+  f.sxy = float(s[1] * inv);
+  f.sxz = float(s[2] * inv);
+  f.syy = float(s[3] * inv);
+  f.syz = float(s[4] * inv);
+  f.szz = float(s[5] * inv);
+  f.spread = float(sigma);
   return f;
 }
 

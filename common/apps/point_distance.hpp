@@ -81,6 +81,7 @@ struct LocalFit {
   float d = 0.0f;
   float ax = 0.0f, ay = 0.0f, az = 0.0f;
   float sxx = 0.0f, sxy = 0.0f, sxz = 0.0f, syy = 0.0f, syz = 0.0f, szz = 0.0f;
+  float spread = 0.0f;  // one_sided_fit only: the robust sigma of the nearest points' offsets
 
   // max_correction bounds the curvature term (a neighbourhood that wraps around a thin
   // part is no local patch; the correction is meant for ~0.1 voxel).
@@ -95,6 +96,17 @@ struct LocalFit {
 
 // The fit at one position (k nearest points of the index). Thread-safe.
 LocalFit local_fit(const PointIndex& index, const Vec3d& x, int k);
+
+// The fit at x of the k nearest points lying on the same sheet as the nearest ones, seen
+// along the unit normal n: t_i = (x - p_i).n; t_ref, the median t of the min(k, 8) nearest,
+// and their robust spread sigma = 1.25 * 1.4826 median |t_i - t_ref| (LocalFit::spread: a local
+// noise estimate); the points with
+// |t_i - t_ref| <= max(3 sigma, min_band) make the fit (symmetric trimming: no bias for
+// symmetric noise). Where a part of the surface is thinner than the neighbourhood, its far
+// sheet (t larger by the thickness) drops out, so the fit is no longer pulled to the part's
+// middle plane (which flattened thin parts, e.g. the bunny's ears, into sheets whose
+// marching-cubes topology followed the noise). Thread-safe.
+LocalFit one_sided_fit(const PointIndex& index, const Vec3d& x, const Vec3d& n, int k, double min_band);
 
 struct PointFitFieldOptions {
   int neighbors = 8;  // k

@@ -39,6 +39,17 @@ constexpr double kSnapWindow = 1.5;
 // Bound on the fits' curvature correction (voxels): a neighbourhood wrapping round a thin
 // part is no local patch. 0.5 measured best on the knot (0.25: bias under k = 24, 1: noise).
 constexpr double kMaxCorrection = 0.5;
+// Snap fits keep the points within max(3 sigma, this many voxels) of the near sheet along the
+// normal (apps/point_distance.hpp one_sided_fit): 2 measured better than 1 on the noisy cases
+// of bench_reconstruct (and the same genus); no trimming gave the bunny's ear a handle.
+constexpr double kOneSidedBand = 2.0;
+// Extra smoothing passes of the snap offsets under noise sigma (voxels): round(gain sigma^2),
+// at most kMaxSmoothing. The heat-equation scale (time sigma^2 / 2, a 3x3x3 box pass ~ h^2 / 3)
+// would give gain 1.5; the fits' noise is spread over their neighbourhoods, so more passes
+// pay: 4 measured best on bench_reconstruct's noisy cases (0.2%: 2-3 passes at the final
+// level), 0 passes on its clean ones.
+constexpr double kSmoothingGain = 4.0;
+constexpr long kMaxSmoothing = 3;
 
 double seconds_since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
 
@@ -69,10 +80,12 @@ void validate(const std::vector<Vec3d>& points, const ReconstructionOptions& o) 
   require(o.max_resolution >= 16, "max_resolution must be >= 16");
 }
 
-// The band with its frame moved by `offset` (values, topology and signs unchanged).
-NarrowBand translated(const NarrowBand& band, const Vec3d& offset) {
+// The band with its frame moved by `offset` and its half-width set to `half_width` voxels
+// (values, active voxels and signs unchanged).
+NarrowBand reframed(const NarrowBand& band, const Vec3d& offset, double half_width) {
   GridFrame frame = band.frame();
   frame.origin = frame.origin + offset;
+  frame.half_width = half_width;
   std::vector<BrickRecord> records(band.brick_count());
   for (std::uint32_t b = 0; b < band.brick_count(); ++b)
     records[b] = {band.bricks()[b].coord, band.bricks()[b].active, band.inside_mask(b)};
@@ -276,7 +289,12 @@ evolve::SpeedFunction fit_speed(const NarrowBand& cache, const std::vector<Local
       const Vec3d nrm{double(b.nx[i]), double(b.ny[i]), double(b.nz[i])};
       const double H = std::clamp(double(b.mean[i]), -1.0 / h, 1.0 / h);
       const double u = double(b.d[i]);
-      const double front_offset = fit.signed_offset(nrm, H, kMaxCorrection * h) - u;
+      // No curvature correction here: with the evolving front's own H it is a backward heat
+      // term (+ (g rho^2 / 4 h) H in beta, rho^2 the fit's tangential spread, larger than the
+      // w d H smoothing for k >~ 12), which grew wrinkles and spurious handles and kept the
+      // flow from converging (knot, 20k points, k = 24: genus 2-8 after 120 steps; without
+      // it genus 1 in 20 steps). The snaps apply it with the coarse level's fixed H.
+      const double front_offset = fit.signed_offset(nrm, H, 0.0) - u;
       const double advective = -std::clamp(kAttractionGain * front_offset / h, -1.0, 1.0);
       const double parabolic = -weight * std::min(double(fit.d), h) * H;
       out.advective[i] = float(advective);
@@ -332,6 +350,8 @@ std::vector<float> mean_curvature_field(const NarrowBand& band) {
 
 struct SnapPass {
   double mean_change = 0.0;     // voxels, over the snapped voxels
+  double noise = 0.0;           // mean robust spread of the fits, voxels
+  int smoothing = 0;            // extra smoothing passes of the offsets
   std::uint64_t voxels = 0;     // snapped (fits computed)
 };
 
@@ -345,6 +365,8 @@ SnapPass snap_to_fits(NarrowBand& band, const PointIndex& index, int neighbors, 
   const float unset = std::numeric_limits<float>::quiet_NaN();
   // 1. The front offset e = clamp(s - u, +-h) of every voxel within the window.
   std::vector<float> offset(band.active_voxel_count(), unset);
+  std::vector<double> spread(band.brick_count(), 0.0);  // per brick: sum of the fits' spread
+  std::vector<std::uint32_t> fitted(band.brick_count(), 0);
   tbb::parallel_for(tbb::blocked_range<std::uint32_t>(0, std::uint32_t(band.brick_count()), 8),
                     [&](const tbb::blocked_range<std::uint32_t>& r) {
                       progress.check("reconstruct snap");
@@ -365,8 +387,10 @@ SnapPass snap_to_fits(NarrowBand& band, const PointIndex& index, int neighbors, 
                           double H = same_grid ? field_at(coarse_acc, coarse, coarse_curvature, c)
                                                : coarse_field_at(coarse_acc, coarse, coarse_curvature, c);
                           if (!std::isfinite(H)) H = 0.0;
-                          const LocalFit fit = local_fit(index, band.world(c), neighbors);
+                          const LocalFit fit = one_sided_fit(index, band.world(c), g / gl, neighbors, kOneSidedBand * h);
                           offset[i] = float(std::clamp(fit.signed_offset(g / gl, H, kMaxCorrection * h) - u, -h, h));
+                          spread[b] += double(fit.spread);
+                          ++fitted[b];
                         });
                       }
                     });
@@ -374,6 +398,50 @@ SnapPass snap_to_fits(NarrowBand& band, const PointIndex& index, int neighbors, 
   // constant along normals, so this averages the fits tangentially (their noise / ~3).
   // Only voxels next to the front may change sign: no new bubbles or handles away from it
   // (the coarse level fixed the topology).
+  // 2a. Noise: the offsets are smoothed tangentially by `smoothing` more 3x3x3 box passes
+  // (each adds ~2/3 h^2 of variance per axis, a heat-equation time of ~1/3 h^2), their
+  // number set by the mean noise estimate sigma of the fits (kSmoothingGain); none on clean
+  // data, where it would only blur.
+  double sigma_sum = 0.0;
+  std::uint64_t sigma_n = 0;
+  for (std::size_t b = 0; b < spread.size(); ++b) {
+    sigma_sum += spread[b];
+    sigma_n += fitted[b];
+  }
+  const double sigma = sigma_n > 0 ? sigma_sum / double(sigma_n) / h : 0.0;
+  const int smoothing = int(std::min<long>(kMaxSmoothing, std::lround(kSmoothingGain * sigma * sigma)));
+  for (int smooth = 0; smooth < smoothing; ++smooth) {
+    std::vector<float> smoothed(offset.size(), unset);
+    tbb::parallel_for(tbb::blocked_range<std::uint32_t>(0, std::uint32_t(band.brick_count()), 8),
+                      [&](const tbb::blocked_range<std::uint32_t>& r) {
+                        BandAccessor acc(band);
+                        for (std::uint32_t b = r.begin(); b != r.end(); ++b) {
+                          std::size_t slot = band.bricks()[b].value_offset;
+                          band.for_each_active_in_brick(b, [&](const Coord& c, float) {
+                            const std::size_t i = slot++;
+                            if (std::isnan(offset[i])) return;
+                            double sum = 0.0;
+                            int n = 0;
+                            for (int dz = -1; dz <= 1; ++dz)
+                              for (int dy = -1; dy <= 1; ++dy)
+                                for (int dx = -1; dx <= 1; ++dx) {
+                                  const Coord q{c.x + dx, c.y + dy, c.z + dz};
+                                  const std::uint32_t qb = acc.locate(brick_of(q));
+                                  if (qb == kNoBrick) continue;
+                                  const Brick& br = band.bricks()[qb];
+                                  const int qn = local_index(q);
+                                  if (!br.active.test(qn)) continue;
+                                  const float e = offset[br.value_offset + br.slot(qn)];
+                                  if (std::isnan(e)) continue;
+                                  sum += double(e);
+                                  ++n;
+                                }
+                            smoothed[i] = float(sum / n);
+                          });
+                        }
+                      });
+    offset.swap(smoothed);
+  }
   std::vector<float> next(band.values().begin(), band.values().end());
   std::vector<double> change(band.brick_count(), 0.0);
   std::vector<std::uint32_t> count(band.brick_count(), 0);
@@ -416,6 +484,8 @@ SnapPass snap_to_fits(NarrowBand& band, const PointIndex& index, int neighbors, 
                     });
   band.swap_values(next);
   SnapPass pass;
+  pass.noise = sigma;
+  pass.smoothing = smoothing;
   for (std::size_t b = 0; b < change.size(); ++b) {
     pass.mean_change += change[b];
     pass.voxels += count[b];
@@ -520,12 +590,20 @@ ReconstructionResult reconstruct_surface(const std::vector<Vec3d>& input, const 
         stage.seconds_fit += seconds_since(t_fit);
         stage.fit_voxels += snapped.voxels;
         stage.last_change = snapped.mean_change;
+        stage.noise = snapped.noise;
+        stage.smoothing = snapped.smoothing;
         ++stage.steps;
         const auto t_redistance = Clock::now();
+        // The snap moved the front by up to one voxel, so voxels up to W + 1 voxels from the
+        // old front may now lie within W of the new one: the domain grows by one voxel
+        // (redistance dilates by W - W_in; one 26-neighbour step reaches one voxel further
+        // from any front). Without it the band misses voxels near the front where the front
+        // moved outward, and the next level's upsampling or the marching cubes (which skip
+        // cells with an inactive corner) leave holes.
         RedistanceOptions redo;
         redo.half_width = W;
         redo.progress = o.progress;
-        band = redistance(band, redo).band;
+        band = redistance(reframed(band, {}, W - 1.0), redo).band;
         stage.seconds_redistance += seconds_since(t_redistance);
         o.progress.step((double(level) + double(pass + 1) / o.snap_passes) / levels, "reconstruct");
         if (stage.last_change < o.tolerance) break;
@@ -535,9 +613,9 @@ ReconstructionResult reconstruct_surface(const std::vector<Vec3d>& input, const 
     stage.active_voxels = band.active_voxel_count();
     stage.seconds = seconds_since(t_level);
     std::snprintf(line, sizeof line,
-                  "level %d: h %.4g, %s %d, change %.4f voxel, %llu voxels, %llu fits; start %.3f s, fits %.3f s, flow "
+                  "level %d: h %.4g, %s %d, change %.4f voxel, noise %.3f voxel, smoothing %d, %llu voxels, %llu fits; start %.3f s, fits %.3f s, flow "
                   "%.3f s, redistance %.3f s, total %.3f s",
-                  level, h, level == 0 ? "flow steps" : "snap passes", stage.steps, stage.last_change,
+                  level, h, level == 0 ? "flow steps" : "snap passes", stage.steps, stage.last_change, stage.noise, stage.smoothing,
                   static_cast<unsigned long long>(stage.active_voxels), static_cast<unsigned long long>(stage.fit_voxels),
                   stage.seconds_start, stage.seconds_fit, stage.seconds_flow, stage.seconds_redistance, stage.seconds);
     log(line);
@@ -546,7 +624,7 @@ ReconstructionResult reconstruct_surface(const std::vector<Vec3d>& input, const 
   }
 
   const auto t_mesh = Clock::now();
-  result.band = translated(band, centre);
+  result.band = reframed(band, centre, band.half_width());
   MarchingCubesOptions mc;
   mc.progress = o.progress;
   result.mesh = marching_cubes(result.band, mc).mesh;

@@ -19,8 +19,9 @@
 //     beta = -clamp(g (s - u) / h, -1, 1) - w * min(d, h) * H,   g = 3,
 //   s = the signed distance of the voxel to the surface the k nearest points sample along the
 //   level set normal (apps/point_distance.hpp LocalFit::signed_offset: the point centroid's
-//   offset along n, corrected by the curvature of the level set), so s - u is the offset of
-//   the front from the data, constant along normals near the data: the flow keeps u a
+//   offset along n, without the curvature correction here: fed by the front's own curvature
+//   it is a backward heat term that grew wrinkles and spurious handles), so s - u is the
+//   offset of the front from the data, constant along normals near the data: the flow keeps u a
 //   distance (no redistance per step) and moves the front by a fixed fraction of its offset
 //   per step: the gradient flow of E_2 = integral of s^2 (thesis eq. 5.4 with p = 2),
 //   converging geometrically to the zero of s, which is linear across a voxel (sub-voxel
@@ -34,11 +35,17 @@
 //   front) is below tolerance voxels per step, or after max_steps.
 //   Finer levels, a snap: the band is resampled (trilinear) at half the voxel size; then
 //   snap_passes times: every voxel within 1.5 voxels of the front computes its front offset
-//   e = clamp(s - u, -h, h) (s along the normal of the current u; the curvature correction
-//   uses the coarse level's H, interpolated, bounded by 0.5 h), moves by the mean e of its
-//   3x3x3 neighbourhood (tangential averaging of the fits' noise), may change sign only
-//   next to the front (no new bubbles or handles), and the band is redistanced (fast
-//   sweeping, W). This is the
+//   e = clamp(s - u, -h, h) from a one-sided fit (point_distance.hpp one_sided_fit: the k
+//   nearest points less those off the near sheet along the normal, so a part thinner than
+//   the neighbourhood is not flattened onto its middle plane; the curvature correction uses
+//   the coarse level's H, interpolated, bounded by 0.5 h); the offsets are smoothed by
+//   round(4 sigma^2) (at most 3) 3x3x3 box passes, sigma the fits' mean noise estimate in
+//   voxels (0 on clean data); each voxel moves by the mean smoothed e of its 3x3x3
+//   neighbourhood (tangential averaging of the fits' noise), may change sign only next to
+//   the front (no new bubbles or handles), and the band is redistanced (fast sweeping, W)
+//   on its domain grown by one voxel (the front moved by up to one voxel; without the growth
+//   the band lacked voxels near the front where it moved outward, and the next upsampling or
+//   the marching cubes left holes). This is the
 //   p = 2 flow's fixed point reached in one step (the flow with the gain g = 2 / dt is the
 //   snap), valid because the upsampled coarse front lies within about a voxel of the data.
 //   Passes stop early when the mean |change| of the snapped voxels is below tolerance.
@@ -47,7 +54,7 @@
 // Cost: coarsest level O(steps * band) plus its fits; finer levels O(snap_passes * (voxels
 //   within 1.5 h of the front * k log N + band)) (fits and redistance); the coarsest level's
 //   dense start grid has (L / h_c + 2 pad)^3 voxels. Knot, 20k points, resolution 256:
-//   about 2 s on 2 cores (tests/bench/bench_reconstruct.cpp).
+//   about 1-1.5 s on 2 cores (tests/bench/bench_reconstruct.cpp).
 // Threading: TBB throughout; the result is identical for any thread count.
 // Errors (thrown): Error{InvalidArgument} for fewer than 4 points, all points equal, bad
 //   options (resolution < 2 (W + 2) + 8, both or neither of resolution / voxel_size,
@@ -97,6 +104,8 @@ struct ReconstructionStage {
   int steps = 0;                // flow steps, or snap passes
   bool converged = false;       // tolerance reached
   double last_change = 0.0;     // voxels: flow: mean front motion per step; snap: mean change
+  double noise = 0.0;           // snap: the fits' mean robust spread (noise estimate), voxels
+  int smoothing = 0;            // snap: extra smoothing passes of the offsets it chose
   std::uint64_t active_voxels = 0;
   std::uint64_t fit_voxels = 0; // local fits computed (cache, or snapped voxels of all passes)
   double seconds = 0.0;         // whole level

@@ -38,7 +38,8 @@ nlohmann::json stages_json(const std::vector<apps::ReconstructionStage>& stages)
   nlohmann::json levels = nlohmann::json::array();
   for (const apps::ReconstructionStage& s : stages)
     levels.push_back({{"level", s.level},        {"voxel_size", s.voxel_size}, {"steps", s.steps},
-                      {"converged", s.converged}, {"last_change", s.last_change}, {"active_voxels", s.active_voxels},
+                      {"converged", s.converged}, {"last_change", s.last_change}, {"noise", s.noise},
+                      {"smoothing", s.smoothing},  {"active_voxels", s.active_voxels},
                       {"fit_voxels", s.fit_voxels}, {"seconds", s.seconds},
                       {"seconds_start", s.seconds_start}, {"seconds_fit", s.seconds_fit},
                       {"seconds_flow", s.seconds_flow}, {"seconds_redistance", s.seconds_redistance}});

@@ -16,6 +16,7 @@
 #include "grid/lsg_file.hpp"
 #include "io/mesh_writer.hpp"
 #include "io/point_cloud_reader.hpp"
+#include "jobs/measures_json.hpp"
 
 namespace levelset::cli {
 
@@ -79,14 +80,7 @@ int run(const ReconstructArgs& a) {
   stats.seconds["mesh"] = r.seconds_mesh;
   stats.seconds["write"] = secs(t2, t3);
   stats.seconds["total"] = secs(t0, t3);
-  nlohmann::json levels = nlohmann::json::array();
-  for (const apps::ReconstructionStage& s : r.stages)
-    levels.push_back({{"level", s.level},        {"voxel_size", s.voxel_size}, {"steps", s.steps},
-                      {"converged", s.converged}, {"last_change", s.last_change}, {"active_voxels", s.active_voxels},
-                      {"fit_voxels", s.fit_voxels}, {"seconds", s.seconds},
-                      {"seconds_start", s.seconds_start}, {"seconds_fit", s.seconds_fit},
-                      {"seconds_flow", s.seconds_flow}, {"seconds_redistance", s.seconds_redistance}});
-  stats.extra["levels"] = levels;
+  stats.extra["levels"] = jobs::stages_json(r.stages);
   stats.extra["points"] = points.size();
   stats.extra["voxel_size"] = r.voxel_size;
   stats.extra["steps"] = r.steps;

@@ -5,7 +5,10 @@
 // Prints per case, side by side: Chamfer and Hausdorff to the true mesh (exact point-to-mesh
 // distances of 200k area samples each way; in units of the bbox diagonal and of our voxel),
 // watertight, genus, seconds. --quick: the knot, 20k clean points, resolution 96, no Poisson.
+// Development switches (any order after the program name): --ours (no Poisson), --mesh NAME
+// (knot.off or bunny00.off), --points N, --noise F (fraction of the diagonal): one case.
 #include <array>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
@@ -51,6 +54,17 @@ std::string script_path() {
 
 int main(int argc, char** argv) {
   const bool quick = bench::is_quick(argc, argv);
+  bool ours_only = quick;
+  std::string only_mesh;
+  long only_points = -1;
+  double only_noise = -1.0;
+  for (int a = 1; a < argc; ++a) {
+    const std::string arg = argv[a];
+    if (arg == "--ours") ours_only = true;
+    if (a + 1 < argc && arg == "--mesh") only_mesh = argv[a + 1];
+    if (a + 1 < argc && arg == "--points") only_points = std::atol(argv[a + 1]);
+    if (a + 1 < argc && arg == "--noise") only_noise = std::atof(argv[a + 1]);
+  }
   return bench::run_bench("bench_reconstruct", "a reconstruction is not watertight", [&] {
     bool ok = true;
     const std::string dir = std::string(LEVELSET_CGAL_DATA) + "/meshes/";
@@ -58,6 +72,7 @@ int main(int argc, char** argv) {
                 "chamfer/h", "hausd/D", "hausd/h", "wt", "genus", "seconds");
     for (const char* name : {"knot.off", "bunny00.off"}) {
       if (quick && std::string(name) != "knot.off") continue;
+      if (!only_mesh.empty() && only_mesh != name) continue;
       const TriangleMesh truth = read_mesh(dir + name).mesh;
       const double diag = length(truth.bounds().extent());
       apps::SurfaceSampleOptions ts;
@@ -67,6 +82,8 @@ int main(int argc, char** argv) {
       for (std::size_t count : {std::size_t(20000), std::size_t(100000)}) {
         for (double noise : {0.0, 0.002}) {
           if (quick && (count != 20000 || noise > 0)) continue;
+          if (only_points >= 0 && std::size_t(only_points) != count) continue;
+          if (only_noise >= 0.0 && std::abs(only_noise - noise) > 1e-12) continue;
           apps::SurfaceSampleOptions ps;
           ps.count = count;
           ps.noise = noise * diag;
@@ -88,7 +105,7 @@ int main(int argc, char** argv) {
           const Row ours = score(truth, truth_samples, r.mesh, ours_s);
           print("levelset", ours);
           ok = ok && ours.watertight;
-          if (quick) continue;
+          if (ours_only) continue;
           const std::filesystem::path tmp = std::filesystem::temp_directory_path();
           const std::string xyz = (tmp / "bench_reconstruct_points.xyz").string();
           const std::string ply = (tmp / "bench_reconstruct_poisson.ply").string();
