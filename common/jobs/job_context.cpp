@@ -239,12 +239,14 @@ NarrowBand JobContext::input_band(const config::Set& input) const {
   return load_lsg(path).band;
 }
 
+const config::Set& JobContext::output_section() const { return section("output", {"mesh", "lsg", "method"}); }
+
 std::string JobContext::output_path(std::string_view file_name) const {
   return (fs::path(options_.output_dir) / std::string(file_name)).string();
 }
 
 void JobContext::write_band(const NarrowBand& band, std::string_view suffix) {
-  const config::Set& out = section("output", {"mesh", "lsg", "method"});
+  const config::Set& out = output_section();
   if (!flag(out, "lsg", true)) return;
   const std::string path = output_path(std::string(stem(options_.name)) + std::string(suffix) + ".lsg");
   save_lsg(band, path);
@@ -252,7 +254,7 @@ void JobContext::write_band(const NarrowBand& band, std::string_view suffix) {
 }
 
 SurfaceResult JobContext::surface_of(const NarrowBand& band) const {
-  const config::Set& out = section("output", {"mesh", "lsg", "method"});
+  const config::Set& out = output_section();
   const std::string method = word(out, "method", "mc", {"mc", "nets"});
   return method == "nets" ? surface_nets(band, {}) : marching_cubes(band, {});
 }
@@ -268,7 +270,7 @@ MeshMeasures JobContext::write_surface(const NarrowBand& band, std::string_view 
 }
 
 void JobContext::write_mesh(const TriangleMesh& mesh, std::string_view suffix) {
-  const config::Set& out = section("output", {"mesh", "lsg", "method"});
+  const config::Set& out = output_section();
   const std::string format = word(out, "mesh", "ply", {"ply", "obj", "off", "stl", "none"});
   if (format == "none") return;
   const std::string path = output_path(std::string(stem(options_.name)) + std::string(suffix) + "." + format);

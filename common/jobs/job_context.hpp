@@ -99,6 +99,7 @@ class JobContext {
 
  private:
   const config::Entry& entry(const config::Set& set, std::string_view key) const;
+  const config::Set& output_section() const;  // output { mesh lsg method }, keys checked
 
   const config::Set& root_;
   JobOptions options_;
