@@ -29,6 +29,9 @@ using KdTree = nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Simple_Adaptor<
                                                    PointSource, 3, std::uint32_t>;
 
 constexpr int kMaxNeighbors = 256;
+// Cholesky pivots below this fraction of the largest diagonal entry: the points do not span
+// the quadric's six functions (e.g. all on a line across a thin part).
+constexpr double kHeightConditioning = 1e-6;
 
 double seconds_since(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
@@ -137,34 +140,51 @@ LocalFit local_fit(const PointIndex& index, const Vec3d& x, int k) {
   return f;
 }
 
-LocalFit one_sided_fit(const PointIndex& index, const Vec3d& x, const Vec3d& n, int k, double min_band) {
+namespace {
+
+// The k nearest points of x trimmed to the near sheet along n (see one_sided_fit), their
+// first and second moments about x, and the trimming's outcome.
+struct Sheet {
   std::array<std::uint32_t, kMaxNeighbors> idx{};
   std::array<double, kMaxNeighbors> d2{};
-  const int count = index.k_nearest(x, std::clamp(k, 1, kMaxNeighbors), idx.data(), d2.data());
-  LocalFit f;
-  if (count == 0) return f;
-  std::array<double, kMaxNeighbors> t{};
-  for (int i = 0; i < count; ++i) t[std::size_t(i)] = dot(x - index.points()[idx[std::size_t(i)]], n);
-  const int m = std::min(count, 8);
+  std::array<double, kMaxNeighbors> t{};  // (x - p_i).n
+  int count = 0;
+  double ref = 0.0;   // the near sheet's t
+  double band = 0.0;  // kept: |t - ref| <= band
+  double sigma = 0.0;
+};
+
+double median_of(std::array<double, 8> v, int size) {
+  for (int i = 1; i < size; ++i)  // insertion sort of at most 8 values
+    for (int j = i; j > 0 && v[std::size_t(j)] < v[std::size_t(j - 1)]; --j) std::swap(v[std::size_t(j)], v[std::size_t(j - 1)]);
+  return size % 2 == 1 ? v[std::size_t(size / 2)] : 0.5 * (v[std::size_t(size / 2 - 1)] + v[std::size_t(size / 2)]);
+}
+
+void find_sheet(const PointIndex& index, const Vec3d& x, const Vec3d& n, int k, double min_band, Sheet& s) {
+  s.count = index.k_nearest(x, std::clamp(k, 1, kMaxNeighbors), s.idx.data(), s.d2.data());
+  if (s.count == 0) return;
+  for (int i = 0; i < s.count; ++i) s.t[std::size_t(i)] = dot(x - index.points()[s.idx[std::size_t(i)]], n);
+  const int m = std::min(s.count, 8);
   std::array<double, 8> near{};
-  for (int i = 0; i < m; ++i) near[std::size_t(i)] = t[std::size_t(i)];
-  auto median = [](std::array<double, 8> v, int size) {
-    for (int i = 1; i < size; ++i)  // insertion sort of at most 8 values
-      for (int j = i; j > 0 && v[std::size_t(j)] < v[std::size_t(j - 1)]; --j) std::swap(v[std::size_t(j)], v[std::size_t(j - 1)]);
-    return size % 2 == 1 ? v[std::size_t(size / 2)] : 0.5 * (v[std::size_t(size / 2 - 1)] + v[std::size_t(size / 2)]);
-  };
-  const double ref = median(near, m);
-  for (int i = 0; i < m; ++i) near[std::size_t(i)] = std::abs(near[std::size_t(i)] - ref);
+  for (int i = 0; i < m; ++i) near[std::size_t(i)] = s.t[std::size_t(i)];
+  s.ref = median_of(near, m);
+  for (int i = 0; i < m; ++i) near[std::size_t(i)] = std::abs(near[std::size_t(i)] - s.ref);
   // 1.4826: the MAD of a normal sample; 1.25: the MAD of 8 values about their own median
   // is ~0.8 of the population's (measured on Gaussian samples of 8).
-  const double sigma = 1.25 * 1.4826 * median(near, m);
-  const double band = std::max(3.0 * sigma, min_band);
+  s.sigma = 1.25 * 1.4826 * median_of(near, m);
+  s.band = std::max(3.0 * s.sigma, min_band);
+}
+
+// The moments of the first `count` kept points of the sheet.
+LocalFit sheet_moments(const PointIndex& index, const Vec3d& x, const Sheet& sh, int count) {
+  LocalFit f;
+  if (sh.count == 0) return f;
   Vec3d a{};
   double s[6] = {0, 0, 0, 0, 0, 0};
   int used = 0;
-  for (int i = 0; i < count; ++i) {
-    if (std::abs(t[std::size_t(i)] - ref) > band) continue;
-    const Vec3d v = x - index.points()[idx[std::size_t(i)]];
+  for (int i = 0; i < std::min(count, sh.count); ++i) {
+    if (std::abs(sh.t[std::size_t(i)] - sh.ref) > sh.band) continue;
+    const Vec3d v = x - index.points()[sh.idx[std::size_t(i)]];
     a += v;
     s[0] += v.x * v.x;
     s[1] += v.x * v.y;
@@ -175,7 +195,7 @@ LocalFit one_sided_fit(const PointIndex& index, const Vec3d& x, const Vec3d& n, 
     ++used;
   }
   const double inv = 1.0 / std::max(used, 1);
-  f.d = float(std::sqrt(d2[0]));
+  f.d = float(std::sqrt(sh.d2[0]));
   f.ax = float(a.x * inv);
   f.ay = float(a.y * inv);
   f.az = float(a.z * inv);
@@ -185,7 +205,94 @@ LocalFit one_sided_fit(const PointIndex& index, const Vec3d& x, const Vec3d& n, 
   f.syy = float(s[3] * inv);
   f.syz = float(s[4] * inv);
   f.szz = float(s[5] * inv);
-  f.spread = float(sigma);
+  f.spread = float(sh.sigma);
+  return f;
+}
+
+// Solves the symmetric positive definite system M c = r (N unknowns) by Cholesky; false when
+// a pivot falls below `relative` times the largest diagonal entry (ill-conditioned).
+template <int N>
+bool solve_spd(std::array<double, N * N>& M, std::array<double, N>& r, double relative) {
+  double scale = 0.0;
+  for (int i = 0; i < N; ++i) scale = std::max(scale, M[std::size_t(i * N + i)]);
+  if (!(scale > 0.0)) return false;
+  for (int j = 0; j < N; ++j) {
+    double d = M[std::size_t(j * N + j)];
+    for (int q = 0; q < j; ++q) d -= M[std::size_t(j * N + q)] * M[std::size_t(j * N + q)];
+    if (!(d > relative * scale)) return false;
+    const double l = std::sqrt(d);
+    M[std::size_t(j * N + j)] = l;
+    for (int i = j + 1; i < N; ++i) {
+      double v = M[std::size_t(i * N + j)];
+      for (int q = 0; q < j; ++q) v -= M[std::size_t(i * N + q)] * M[std::size_t(j * N + q)];
+      M[std::size_t(i * N + j)] = v / l;
+    }
+  }
+  for (int i = 0; i < N; ++i) {  // L y = r
+    double v = r[std::size_t(i)];
+    for (int q = 0; q < i; ++q) v -= M[std::size_t(i * N + q)] * r[std::size_t(q)];
+    r[std::size_t(i)] = v / M[std::size_t(i * N + i)];
+  }
+  for (int i = N - 1; i >= 0; --i) {  // L^T c = y
+    double v = r[std::size_t(i)];
+    for (int q = i + 1; q < N; ++q) v -= M[std::size_t(q * N + i)] * r[std::size_t(q)];
+    r[std::size_t(i)] = v / M[std::size_t(i * N + i)];
+  }
+  return true;
+}
+
+}  // namespace
+
+LocalFit one_sided_fit(const PointIndex& index, const Vec3d& x, const Vec3d& n, int k, double min_band) {
+  Sheet sh;
+  find_sheet(index, x, n, k, min_band, sh);
+  return sheet_moments(index, x, sh, sh.count);
+}
+
+SheetFit sheet_fit(const PointIndex& index, const Vec3d& x, const Vec3d& n, int k, int k_height, double min_band) {
+  Sheet sh;
+  find_sheet(index, x, n, std::max(k, k_height), min_band, sh);
+  SheetFit f;
+  f.plane = sheet_moments(index, x, sh, k);
+  // Height function z(xi, eta) over the tangent plane of n at x, in units of the kept
+  // points' tangential radius R (conditioning), weights exp(-rho^2 / R^2).
+  const Vec3d t1 = std::abs(n.x) < 0.6 ? cross(n, Vec3d{1, 0, 0}) : cross(n, Vec3d{0, 1, 0});
+  const Vec3d e1 = t1 / length(t1);
+  const Vec3d e2 = cross(n, e1);
+  struct Local {
+    double xi, eta, z;
+  };
+  std::array<Local, kMaxNeighbors> pts{};
+  int used = 0;
+  double r2max = 0.0;
+  for (int i = 0; i < std::min(k_height, sh.count); ++i) {
+    if (std::abs(sh.t[std::size_t(i)] - sh.ref) > sh.band) continue;
+    const Vec3d v = index.points()[sh.idx[std::size_t(i)]] - x;
+    const Local l{dot(v, e1), dot(v, e2), dot(v, n)};
+    r2max = std::max(r2max, l.xi * l.xi + l.eta * l.eta);
+    pts[std::size_t(used++)] = l;
+  }
+  if (used < 10 || !(r2max > 0.0)) return f;
+  const double inv_r = 1.0 / std::sqrt(r2max);
+  std::array<double, 36> M{};
+  std::array<double, 6> r{};
+  for (int i = 0; i < used; ++i) {
+    const double u = pts[std::size_t(i)].xi * inv_r, v = pts[std::size_t(i)].eta * inv_r;
+    const double w = std::exp(-(u * u + v * v));
+    const double phi[6] = {1.0, u, v, u * u, u * v, v * v};
+    for (int a = 0; a < 6; ++a) {
+      r[std::size_t(a)] += w * phi[a] * pts[std::size_t(i)].z;
+      for (int b = 0; b <= a; ++b) M[std::size_t(a * 6 + b)] += w * phi[a] * phi[b];
+    }
+  }
+  for (int a = 0; a < 6; ++a)
+    for (int b = a + 1; b < 6; ++b) M[std::size_t(a * 6 + b)] = M[std::size_t(b * 6 + a)];
+  if (!solve_spd<6>(M, r, kHeightConditioning)) return f;
+  // The surface crosses the normal line at x + z0 n; x's signed offset along the surface's
+  // normal is -z0 cos(tilt), the slope (z_xi, z_eta) = (r1, r2) / R.
+  const double slope2 = (r[1] * r[1] + r[2] * r[2]) * inv_r * inv_r;
+  f.height_offset = -r[0] / std::sqrt(1.0 + slope2);
+  f.has_height = true;
   return f;
 }
 

@@ -108,6 +108,22 @@ LocalFit local_fit(const PointIndex& index, const Vec3d& x, int k);
 // marching-cubes topology followed the noise). Thread-safe.
 LocalFit one_sided_fit(const PointIndex& index, const Vec3d& x, const Vec3d& n, int k, double min_band);
 
+// The one-sided fit of the first k points and a second-order fit of the first k_height
+// (both trimmed to the near sheet as one_sided_fit): in the frame of the unit normal n at x,
+// the height z = c0 + c1 xi + c2 eta + c3 xi^2 + c4 xi eta + c5 eta^2 of the points above the
+// tangent plane, by least squares weighted exp(-rho^2 / R^2) (rho the tangential distance
+// from x, R the largest among the kept points). height_offset = -c0 / sqrt(1 + |grad z|^2)
+// is x's signed distance to that quadric: no bias from the surface's curvature (the plane /
+// centroid fit's O(rho^2 H)) and no dependence on where the points lie around x, so it
+// needs no curvature correction. has_height is false (height_offset 0) with fewer than 10
+// kept points or an ill-conditioned system. Thread-safe.
+struct SheetFit {
+  LocalFit plane;
+  double height_offset = 0.0;
+  bool has_height = false;
+};
+SheetFit sheet_fit(const PointIndex& index, const Vec3d& x, const Vec3d& n, int k, int k_height, double min_band);
+
 struct PointFitFieldOptions {
   int neighbors = 8;  // k
   ProgressHook progress;

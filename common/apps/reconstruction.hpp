@@ -35,31 +35,41 @@
 //   front) is below tolerance voxels per step, or after max_steps.
 //   Finer levels, a snap: the band is resampled (trilinear) at half the voxel size; then
 //   snap_passes times: every voxel within 1.5 voxels of the front computes its front offset
-//   e = clamp(s - u, -h, h) from a one-sided fit (point_distance.hpp one_sided_fit: the k
-//   nearest points less those off the near sheet along the normal, so a part thinner than
-//   the neighbourhood is not flattened onto its middle plane; the curvature correction uses
-//   the coarse level's H, interpolated, bounded by 0.5 h); the offsets are smoothed by
-//   round(4 sigma^2) (at most 3) 3x3x3 box passes, sigma the fits' mean noise estimate in
-//   voxels (0 on clean data); each voxel moves by the mean smoothed e of its 3x3x3
-//   neighbourhood (tangential averaging of the fits' noise), may change sign only next to
-//   the front (no new bubbles or handles), and the band is redistanced (fast sweeping, W)
+//   e = clamp(s - u, -h, h) from fits of the points near the voxel (point_distance.hpp
+//   sheet_fit: the nearest points less those off the near sheet along the normal, so a part
+//   thinner than the neighbourhood is not flattened onto its middle plane), two of them:
+//   the plane (centroid) fit of the k nearest, with the curvature correction from the coarse
+//   level's H (interpolated, bounded by 0.5 h), and a second-order fit, the weighted least
+//   squares quadric height function over the level set's tangent plane of max(k, 16) points
+//   (unbiased by curvature; used where well-conditioned and within h of the plane fit's).
+//   sigma, the fits' mean noise estimate, decides between them: clean data (sigma < 0.4
+//   final voxels) take the second-order offsets, each voxel moving by the mean e of itself
+//   and its 6 face neighbours (later passes refit only the voxels within 1 voxel of the front);
+//   noisy data take the plane offsets (lower variance), smoothed by round(4 sigma^2) (at most
+//   3) 3x3x3 box passes (sigma in this level's voxels), and each voxel moves by the mean e of
+//   its 3x3x3 neighbourhood (tangential averaging of the fits' noise). A voxel may change
+//   sign only next to the front (no new bubbles or handles), and the band is redistanced (fast sweeping, W)
 //   on its domain grown by one voxel (the front moved by up to one voxel; without the growth
 //   the band lacked voxels near the front where it moved outward, and the next upsampling or
 //   the marching cubes left holes). This is the
 //   p = 2 flow's fixed point reached in one step (the flow with the gain g = 2 / dt is the
 //   snap), valid because the upsampled coarse front lies within about a voxel of the data.
-//   Passes stop early when the mean |change| of the snapped voxels is below tolerance.
+//   Passes (snap_passes per level; on the final level at least clean_final_passes when the
+//   first pass found the data clean: the second pass refits along the corrected normals)
+//   stop early when the mean |change| of the snapped voxels is below tolerance.
 //   Output mesh: marching cubes of the final band (watertight by construction).
 // Output: ReconstructionResult (band in the input's world frame, mesh, measures, stages).
 // Cost: coarsest level O(steps * band) plus its fits; finer levels O(snap_passes * (voxels
-//   within 1.5 h of the front * k log N + band)) (fits and redistance); the coarsest level's
-//   dense start grid has (L / h_c + 2 pad)^3 voxels. Knot, 20k points, resolution 256:
-//   about 1-1.5 s on 2 cores (tests/bench/bench_reconstruct.cpp).
+//   within 1.5 h of the front * (max(k, 16) log N + a 6x6 solve) + band)) (fits and
+//   redistance); the coarsest level's dense start grid has (L / h_c + 2 pad)^3 voxels.
+//   bench_reconstruct, resolution 256, 2 shared cores: 1.6-2.3 s for 20k-100k points (the
+//   final level's second clean pass is ~0.5 s of it).
 // Threading: TBB throughout; the result is identical for any thread count.
 // Errors (thrown): Error{InvalidArgument} for fewer than 4 points, all points equal, bad
 //   options (resolution < 2 (W + 2) + 8, both or neither of resolution / voxel_size,
 //   half_width not in [2, 8], levels not in [1, 6], neighbors not in [1, 256], negative
-//   curvature weight, tolerance <= 0, max_steps < 1, snap_passes not in [0, 16],
+//   curvature weight, tolerance <= 0, max_steps < 1, snap_passes or clean_final_passes not in
+//   [0, 16],
 //   shell_offset not in [1, 16]);
 //   Error{NonFinite} for a non-finite point (naming it) or option; Error{LimitExceeded}
 //   when the final grid would exceed max_resolution voxels along a side or the coarsest
@@ -91,7 +101,8 @@ struct ReconstructionOptions {
   int neighbors = 8;            // k points per local surface fit (more: smoother under noise)
   double curvature_weight = 0.3;  // w of the coarsest level's flow
   int max_steps = 120;          // coarsest level's flow
-  int snap_passes = 1;          // per finer level (more drift: 1 measured best)
+  int snap_passes = 1;          // per finer level (noisy data: more drift, 1 measured best)
+  int clean_final_passes = 2;   // final level, clean data (second-order snaps): at least this many
   double tolerance = 0.01;      // voxels: flow: mean front motion per step; snap: mean change
   int max_resolution = 4096;    // cap on the final grid's longest side (voxels)
   ProgressHook progress;
@@ -106,6 +117,8 @@ struct ReconstructionStage {
   double last_change = 0.0;     // voxels: flow: mean front motion per step; snap: mean change
   double noise = 0.0;           // snap: the fits' mean robust spread (noise estimate), voxels
   int smoothing = 0;            // snap: extra smoothing passes of the offsets it chose
+  bool second_order = false;    // snap: clean data: the height fits' offsets, unaveraged (last pass)
+  std::uint64_t height_fits = 0;  // snap: fits whose height fit was usable (all passes)
   std::uint64_t active_voxels = 0;
   std::uint64_t fit_voxels = 0; // local fits computed (cache, or snapped voxels of all passes)
   double seconds = 0.0;         // whole level

@@ -39,7 +39,8 @@ nlohmann::json stages_json(const std::vector<apps::ReconstructionStage>& stages)
   for (const apps::ReconstructionStage& s : stages)
     levels.push_back({{"level", s.level},        {"voxel_size", s.voxel_size}, {"steps", s.steps},
                       {"converged", s.converged}, {"last_change", s.last_change}, {"noise", s.noise},
-                      {"smoothing", s.smoothing},  {"active_voxels", s.active_voxels},
+                      {"smoothing", s.smoothing},  {"second_order", s.second_order},
+                      {"height_fits", s.height_fits}, {"active_voxels", s.active_voxels},
                       {"fit_voxels", s.fit_voxels}, {"seconds", s.seconds},
                       {"seconds_start", s.seconds_start}, {"seconds_fit", s.seconds_fit},
                       {"seconds_flow", s.seconds_flow}, {"seconds_redistance", s.seconds_redistance}});

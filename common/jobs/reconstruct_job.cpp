@@ -6,7 +6,8 @@
 //   input { points = FILE (.xyz .xyzn .pwn .ply)  |  sample = knot  |  sample_mesh = FILE
 //           count = 20000  noise = 0 (x the bbox diagonal)  seed = 1 }
 //   reconstruct { levels = 3  neighbors = 8  curvature_weight = 0.3  max_steps = 120
-//                 snap_passes = 1  tolerance = 0.01  shell_offset = 2  accuracy_samples = 100000 }
+//                 snap_passes = 1  clean_final_passes = 2  tolerance = 0.01  shell_offset = 2
+//                 accuracy_samples = 100000 }
 // The raster's resolution / voxel_size / band are the final level's.
 #include <functional>
 #include <memory>
@@ -25,7 +26,7 @@ namespace levelset::jobs {
 void run_reconstruct_job(JobContext& ctx) {
   const config::Set& in = ctx.section("input", {"points", "sample", "sample_mesh", "count", "noise", "seed"});
   const config::Set& s = ctx.section("reconstruct", {"levels", "neighbors", "curvature_weight", "max_steps", "snap_passes",
-                                                     "tolerance", "shell_offset", "accuracy_samples"});
+                                                     "clean_final_passes", "tolerance", "shell_offset", "accuracy_samples"});
   const int given = (ctx.has(in, "points") ? 1 : 0) + (ctx.has(in, "sample") ? 1 : 0) + (ctx.has(in, "sample_mesh") ? 1 : 0);
   if (given != 1)
     throw Error(ErrorCode::InvalidArgument, ctx.options().name,
@@ -71,6 +72,7 @@ void run_reconstruct_job(JobContext& ctx) {
   o.curvature_weight = ctx.number(s, "curvature_weight", o.curvature_weight, 0.0, 100.0);
   o.max_steps = ctx.integer(s, "max_steps", o.max_steps, 1, 100000);
   o.snap_passes = ctx.integer(s, "snap_passes", o.snap_passes, 0, 16);
+  o.clean_final_passes = ctx.integer(s, "clean_final_passes", o.clean_final_passes, 0, 16);
   o.tolerance = ctx.number(s, "tolerance", o.tolerance, 1e-9, 10.0);
   o.shell_offset = ctx.number(s, "shell_offset", o.shell_offset, 1.0, 16.0);
   o.progress = ctx.options().progress;

@@ -110,6 +110,7 @@ Command add_reconstruct_command(CLI::App& app, int& threads) {
   auto& o = args->options;
   sub->add_option("--curvature-weight", o.curvature_weight, "Curvature weight of the coarsest level's flow")->capture_default_str();
   sub->add_option("--snap-passes", o.snap_passes, "Snap passes per finer level")->capture_default_str();
+  sub->add_option("--clean-final-passes", o.clean_final_passes, "Snap passes at the final level on clean data (second-order fits)")->capture_default_str();
   sub->add_option("--neighbors", o.neighbors, "Points per local surface fit")->capture_default_str();
   sub->add_option("--levels", o.levels, "Coarse-to-fine levels")->capture_default_str();
   sub->add_option("--band", o.half_width, "Band half-width (voxels)")->capture_default_str();

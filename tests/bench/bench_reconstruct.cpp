@@ -6,7 +6,8 @@
 // distances of 200k area samples each way; in units of the bbox diagonal and of our voxel),
 // watertight, genus, seconds. --quick: the knot, 20k clean points, resolution 96, no Poisson.
 // Development switches (any order after the program name): --ours (no Poisson), --mesh NAME
-// (knot.off or bunny00.off), --points N, --noise F (fraction of the diagonal): one case.
+// (knot.off or bunny00.off), --points N, --noise F (fraction of the diagonal): one case;
+// --log: the reconstruction's per-level lines on stderr.
 #include <array>
 #include <cmath>
 #include <cstdio>
@@ -55,12 +56,14 @@ std::string script_path() {
 int main(int argc, char** argv) {
   const bool quick = bench::is_quick(argc, argv);
   bool ours_only = quick;
+  bool log_stages = false;
   std::string only_mesh;
   long only_points = -1;
   double only_noise = -1.0;
   for (int a = 1; a < argc; ++a) {
     const std::string arg = argv[a];
     if (arg == "--ours") ours_only = true;
+    if (arg == "--log") log_stages = true;
     if (a + 1 < argc && arg == "--mesh") only_mesh = argv[a + 1];
     if (a + 1 < argc && arg == "--points") only_points = std::atol(argv[a + 1]);
     if (a + 1 < argc && arg == "--noise") only_noise = std::atof(argv[a + 1]);
@@ -92,6 +95,7 @@ int main(int argc, char** argv) {
           apps::ReconstructionOptions o;
           o.resolution = quick ? 96 : 256;
           if (noise > 0) o.neighbors = 24;
+          if (log_stages) o.log = [](const std::string& line) { std::fprintf(stderr, "  %s\n", line.c_str()); };
           const auto t0 = std::chrono::steady_clock::now();
           const apps::ReconstructionResult r = apps::reconstruct_surface(points, o);
           const double ours_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
