@@ -157,7 +157,7 @@ def check_reconstruct_knot(run):
     s = run(base)
     mesh_ok(s["mesh"], genus=1, components=1)
     a = s["accuracy"]
-    assert a["chamfer_voxels"] < 0.15 and a["hausdorff_voxels"] < 1.5, a
+    assert a["chamfer_voxels"] < 0.05 and a["hausdorff_voxels"] < 0.5, a
     assert s["reconstruct"]["points"] == 20000 and len(s["reconstruct"]["levels"]) >= 2, s["reconstruct"]
     # Noise of 0.2% of the diagonal: still the right topology, and closer to the truth than
     # the points themselves are (mean |noise| = 0.8 sigma).
