@@ -29,6 +29,8 @@
 //   Weno5 is about 60 flops and 4 divisions per side. Threading: pure functions.
 #pragma once
 
+#include <string_view>
+
 #include <algorithm>
 #include <limits>
 #include <cmath>
@@ -37,6 +39,10 @@
 namespace levelset::evolve {
 
 enum class Scheme { Upwind1, Eno2, Weno5 };
+
+// "godunov" (first-order upwind, the thesis's), "eno2", "weno5": the names the CLI and job
+// files use. Error{InvalidArgument} for anything else.
+Scheme scheme_from_name(std::string_view name);
 
 // Samples needed on each side of the centre by the widest scheme (Weno5).
 inline constexpr int kStencilReach = 3;

@@ -805,4 +805,20 @@ EvolutionResult evolve(const NarrowBand& band, const EvolutionOptions& options) 
   return result;
 }
 
+std::string_view to_string(StopReason reason) {
+  switch (reason) {
+    case StopReason::Completed: return "completed";
+    case StopReason::Cancelled: return "cancelled";
+    case StopReason::NonFinite: return "non-finite";
+  }
+  return "?";
+}
+
+Scheme scheme_from_name(std::string_view name) {
+  if (name == "godunov") return Scheme::Upwind1;
+  if (name == "eno2") return Scheme::Eno2;
+  if (name == "weno5") return Scheme::Weno5;
+  throw Error(ErrorCode::InvalidArgument, "scheme", "unknown scheme '" + std::string(name) + "' (known: godunov, eno2, weno5)");
+}
+
 }  // namespace levelset::evolve

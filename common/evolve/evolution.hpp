@@ -136,4 +136,7 @@ struct EvolutionResult {
 
 EvolutionResult evolve(const NarrowBand& band, const EvolutionOptions& options);
 
+// "completed", "cancelled", "non-finite".
+std::string_view to_string(StopReason reason);
+
 }  // namespace levelset::evolve

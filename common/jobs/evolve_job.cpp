@@ -13,19 +13,6 @@
 
 namespace levelset::jobs {
 
-namespace {
-
-const char* stop_name(evolve::StopReason r) {
-  switch (r) {
-    case evolve::StopReason::Completed: return "completed";
-    case evolve::StopReason::Cancelled: return "cancelled";
-    case evolve::StopReason::NonFinite: return "non-finite";
-  }
-  return "?";
-}
-
-}  // namespace
-
 // Shared by the jobs that run the evolution engine with a speed from their set.
 evolve::EvolutionOptions evolution_options_from(JobContext& ctx, const config::Set& s) {
   evolve::EvolutionOptions o;
@@ -46,7 +33,7 @@ evolve::EvolutionOptions evolution_options_from(JobContext& ctx, const config::S
   o.steps = ctx.integer(s, "steps", 0, 1, 100000000);
   o.time = ctx.number(s, "time", 0, 1e-300, 1e300);
   const std::string scheme = ctx.word(s, "scheme", "godunov", {"godunov", "eno2", "weno5"});
-  o.scheme = scheme == "weno5" ? evolve::Scheme::Weno5 : scheme == "eno2" ? evolve::Scheme::Eno2 : evolve::Scheme::Upwind1;
+  o.scheme = evolve::scheme_from_name(scheme);
   o.rk_order = ctx.integer(s, "rk", 1, 1, 3);
   if (o.rk_order == 2) throw Error(ErrorCode::InvalidArgument, ctx.place(s, "rk"), "rk must be 1 or 3");
   o.cfl = ctx.number(s, "cfl", 0.0, 0.0, 1.0);
@@ -70,7 +57,7 @@ evolve::EvolutionOptions evolution_options_from(JobContext& ctx, const config::S
 nlohmann::json evolution_json(const evolve::EvolutionResult& r) {
   return {{"steps", r.steps},
           {"time", r.time},
-          {"stop", stop_name(r.stop)},
+          {"stop", std::string(evolve::to_string(r.stop))},
           {"redistance_count", r.redistance_count},
           {"landmine_count", r.landmine_count},
           {"band_updates", r.band_updates},
@@ -89,7 +76,7 @@ void run_evolve_job(JobContext& ctx) {
   const evolve::EvolutionResult result = evolve::evolve(band, options);
   ctx.stats()["evolution"] = evolution_json(result);
   ctx.log("evolved " + std::to_string(result.steps) + " steps to t = " + std::to_string(result.time) + " (" +
-          stop_name(result.stop) + ")");
+          std::string(evolve::to_string(result.stop)) + ")");
   ctx.write_band(result.band);
   ctx.write_surface(result.band);
   if (result.stop == evolve::StopReason::NonFinite) throw Error(ErrorCode::NonFinite, "evolve", result.message);

@@ -20,8 +20,7 @@ namespace levelset::jobs {
 namespace {
 
 evolve::Scheme scheme_of(JobContext& ctx, const config::Set& s, const char* fallback) {
-  const std::string name = ctx.word(s, "scheme", fallback, {"godunov", "eno2", "weno5"});
-  return name == "weno5" ? evolve::Scheme::Weno5 : name == "eno2" ? evolve::Scheme::Eno2 : evolve::Scheme::Upwind1;
+  return evolve::scheme_from_name(ctx.word(s, "scheme", fallback, {"godunov", "eno2", "weno5"}));
 }
 
 }  // namespace

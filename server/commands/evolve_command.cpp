@@ -14,25 +14,6 @@
 
 namespace levelset::cli {
 
-namespace {
-
-evolve::Scheme scheme_from(const std::string& s) {
-  if (s == "eno2") return evolve::Scheme::Eno2;
-  if (s == "weno5") return evolve::Scheme::Weno5;
-  return evolve::Scheme::Upwind1;
-}
-
-const char* stop_name(evolve::StopReason r) {
-  switch (r) {
-    case evolve::StopReason::Completed: return "completed";
-    case evolve::StopReason::Cancelled: return "cancelled";
-    case evolve::StopReason::NonFinite: return "non-finite";
-  }
-  return "?";
-}
-
-}  // namespace
-
 int run_evolve(const EvolveArgs& args) {
   const auto t0 = std::chrono::steady_clock::now();
   const LsgReadResult in = load_lsg(args.input);
@@ -55,7 +36,7 @@ int run_evolve(const EvolveArgs& args) {
     options.velocity.kind = evolve::Velocity::Kind::Constant;
     options.velocity.constant = {args.velocity[0], args.velocity[1], args.velocity[2]};
   }
-  options.scheme = scheme_from(args.scheme);
+  options.scheme = evolve::scheme_from_name(args.scheme);
   options.hamiltonian = args.hamiltonian == "llf" ? evolve::Hamiltonian::LaxFriedrichs : evolve::Hamiltonian::Godunov;
   options.rk_order = args.rk;
   options.cfl = args.cfl;
@@ -80,7 +61,7 @@ int run_evolve(const EvolveArgs& args) {
   auto secs = [](auto a, auto b) { return std::chrono::duration<double>(b - a).count(); };
 
   std::fprintf(out, "%s: %d steps to t = %.6g (%s), %zu -> %zu active voxels, %d redistances, %.3f s -> %s (%s)\n",
-               args.input.c_str(), result.steps, result.time, stop_name(result.stop), in.band.active_voxel_count(),
+               args.input.c_str(), result.steps, result.time, evolve::to_string(result.stop).data(), in.band.active_voxel_count(),
                result.band.active_voxel_count(), result.redistance_count, secs(t1, t2), args.output.c_str(),
                human_bytes(written.file_bytes).c_str());
   Stats stats("evolve", result.band);
@@ -102,7 +83,7 @@ int run_evolve(const EvolveArgs& args) {
   stats.extra["cfl"] = args.cfl;
   stats.extra["steps"] = result.steps;
   stats.extra["time"] = result.time;
-  stats.extra["stop"] = stop_name(result.stop);
+  stats.extra["stop"] = evolve::to_string(result.stop).data();
   stats.extra["redistance_count"] = result.redistance_count;
   stats.extra["landmine_count"] = result.landmine_count;
   stats.extra["activated"] = result.activated;
