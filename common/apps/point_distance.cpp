@@ -108,16 +108,14 @@ PointDistanceResult point_distance(const PointIndex& index, std::span<const Vec3
   return r;
 }
 
-LocalFit local_fit(const PointIndex& index, const Vec3d& x, int k) {
-  std::array<std::uint32_t, kMaxNeighbors> idx{};
-  std::array<double, kMaxNeighbors> d2{};
-  const int n = index.k_nearest(x, std::clamp(k, 1, kMaxNeighbors), idx.data(), d2.data());
-  LocalFit f;
-  if (n == 0) return f;
+namespace {
+
+// First and second moments of offsets v = x - p, divided into a LocalFit (d set by the caller).
+struct Moments {
   Vec3d a{};
   double s[6] = {0, 0, 0, 0, 0, 0};
-  for (int i = 0; i < n; ++i) {
-    const Vec3d v = x - index.points()[idx[std::size_t(i)]];
+  int n = 0;
+  void add(const Vec3d& v) {
     a += v;
     s[0] += v.x * v.x;
     s[1] += v.x * v.y;
@@ -125,19 +123,35 @@ LocalFit local_fit(const PointIndex& index, const Vec3d& x, int k) {
     s[3] += v.y * v.y;
     s[4] += v.y * v.z;
     s[5] += v.z * v.z;
+    ++n;
   }
-  const double inv = 1.0 / n;
-  f.d = float(std::sqrt(d2[0]));
-  f.ax = float(a.x * inv);
-  f.ay = float(a.y * inv);
-  f.az = float(a.z * inv);
-  f.sxx = float(s[0] * inv);
-  f.sxy = float(s[1] * inv);
-  f.sxz = float(s[2] * inv);
-  f.syy = float(s[3] * inv);
-  f.syz = float(s[4] * inv);
-  f.szz = float(s[5] * inv);
-  return f;
+  LocalFit fit(double distance) const {
+    LocalFit f;
+    const double inv = 1.0 / std::max(n, 1);
+    f.d = float(distance);
+    f.ax = float(a.x * inv);
+    f.ay = float(a.y * inv);
+    f.az = float(a.z * inv);
+    f.sxx = float(s[0] * inv);
+    f.sxy = float(s[1] * inv);
+    f.sxz = float(s[2] * inv);
+    f.syy = float(s[3] * inv);
+    f.syz = float(s[4] * inv);
+    f.szz = float(s[5] * inv);
+    return f;
+  }
+};
+
+}  // namespace
+
+LocalFit local_fit(const PointIndex& index, const Vec3d& x, int k) {
+  std::array<std::uint32_t, kMaxNeighbors> idx{};
+  std::array<double, kMaxNeighbors> d2{};
+  const int n = index.k_nearest(x, std::clamp(k, 1, kMaxNeighbors), idx.data(), d2.data());
+  if (n == 0) return {};
+  Moments m;
+  for (int i = 0; i < n; ++i) m.add(x - index.points()[idx[std::size_t(i)]]);
+  return m.fit(std::sqrt(d2[0]));
 }
 
 namespace {
@@ -177,34 +191,13 @@ void find_sheet(const PointIndex& index, const Vec3d& x, const Vec3d& n, int k, 
 
 // The moments of the first `count` kept points of the sheet.
 LocalFit sheet_moments(const PointIndex& index, const Vec3d& x, const Sheet& sh, int count) {
-  LocalFit f;
-  if (sh.count == 0) return f;
-  Vec3d a{};
-  double s[6] = {0, 0, 0, 0, 0, 0};
-  int used = 0;
+  if (sh.count == 0) return {};
+  Moments m;
   for (int i = 0; i < std::min(count, sh.count); ++i) {
     if (std::abs(sh.t[std::size_t(i)] - sh.ref) > sh.band) continue;
-    const Vec3d v = x - index.points()[sh.idx[std::size_t(i)]];
-    a += v;
-    s[0] += v.x * v.x;
-    s[1] += v.x * v.y;
-    s[2] += v.x * v.z;
-    s[3] += v.y * v.y;
-    s[4] += v.y * v.z;
-    s[5] += v.z * v.z;
-    ++used;
+    m.add(x - index.points()[sh.idx[std::size_t(i)]]);
   }
-  const double inv = 1.0 / std::max(used, 1);
-  f.d = float(std::sqrt(sh.d2[0]));
-  f.ax = float(a.x * inv);
-  f.ay = float(a.y * inv);
-  f.az = float(a.z * inv);
-  f.sxx = float(s[0] * inv);
-  f.sxy = float(s[1] * inv);
-  f.sxz = float(s[2] * inv);
-  f.syy = float(s[3] * inv);
-  f.syz = float(s[4] * inv);
-  f.szz = float(s[5] * inv);
+  LocalFit f = m.fit(std::sqrt(sh.d2[0]));
   f.spread = float(sh.sigma);
   return f;
 }

@@ -26,6 +26,23 @@ namespace levelset::apps {
 
 namespace {
 
+// Calls f(|dx| + |dy| + |dz|, value index) for every active voxel of the 3x3x3 block around c
+// (c itself included, with 0).
+template <typename F>
+void for_each_active_neighbour27(const NarrowBand& band, BandAccessor& acc, const Coord& c, F&& f) {
+  for (int dz = -1; dz <= 1; ++dz)
+    for (int dy = -1; dy <= 1; ++dy)
+      for (int dx = -1; dx <= 1; ++dx) {
+        const Coord q{c.x + dx, c.y + dy, c.z + dz};
+        const std::uint32_t qb = acc.locate(brick_of(q));
+        if (qb == kNoBrick) continue;
+        const Brick& br = band.bricks()[qb];
+        const int qn = local_index(q);
+        if (!br.active.test(qn)) continue;
+        f(std::abs(dx) + std::abs(dy) + std::abs(dz), br.value_offset + br.slot(qn));
+      }
+}
+
 using Clock = std::chrono::steady_clock;
 
 // The coarsest level's attraction: beta = -clamp(gain * offset / h): a front within
@@ -459,20 +476,11 @@ SnapPass snap_to_fits(NarrowBand& band, const PointIndex& index, int neighbors, 
                             if (std::isnan(offset[i])) return;
                             double sum = 0.0;
                             int n = 0;
-                            for (int dz = -1; dz <= 1; ++dz)
-                              for (int dy = -1; dy <= 1; ++dy)
-                                for (int dx = -1; dx <= 1; ++dx) {
-                                  const Coord q{c.x + dx, c.y + dy, c.z + dz};
-                                  const std::uint32_t qb = acc.locate(brick_of(q));
-                                  if (qb == kNoBrick) continue;
-                                  const Brick& br = band.bricks()[qb];
-                                  const int qn = local_index(q);
-                                  if (!br.active.test(qn)) continue;
-                                  const float e = offset[br.value_offset + br.slot(qn)];
-                                  if (std::isnan(e)) continue;
-                                  sum += double(e);
-                                  ++n;
-                                }
+                            for_each_active_neighbour27(band, acc, c, [&](int, std::size_t j) {
+                              if (std::isnan(offset[j])) return;
+                              sum += double(offset[j]);
+                              ++n;
+                            });
                             smoothed[i] = float(sum / n);
                           });
                         }
@@ -495,23 +503,13 @@ SnapPass snap_to_fits(NarrowBand& band, const PointIndex& index, int neighbors, 
                           bool at_front = false;
                           double sum = 0.0;
                           int n = 0;
-                          for (int dz = -1; dz <= 1; ++dz)
-                            for (int dy = -1; dy <= 1; ++dy)
-                              for (int dx = -1; dx <= 1; ++dx) {
-                                const Coord q{c.x + dx, c.y + dy, c.z + dz};
-                                const std::uint32_t qb = acc.locate(brick_of(q));
-                                if (qb == kNoBrick) continue;
-                                const Brick& br = band.bricks()[qb];
-                                const int qn = local_index(q);
-                                if (!br.active.test(qn)) continue;
-                                const std::size_t j = br.value_offset + br.slot(qn);
-                                if (std::abs(dx) + std::abs(dy) + std::abs(dz) == 1 && (band.values()[j] < 0.0f) != inside)
-                                  at_front = true;
-                                if (std::isnan(offset[j])) continue;
-                                if (clean && std::abs(dx) + std::abs(dy) + std::abs(dz) > 1) continue;
-                                sum += double(offset[j]);
-                                ++n;
-                              }
+                          for_each_active_neighbour27(band, acc, c, [&](int taxicab, std::size_t j) {
+                            if (taxicab == 1 && (band.values()[j] < 0.0f) != inside) at_front = true;
+                            if (std::isnan(offset[j])) return;
+                            if (clean && taxicab > 1) return;
+                            sum += double(offset[j]);
+                            ++n;
+                          });
                           double target = u + sum / n;
                           if (!at_front && (target < 0.0) != inside) target = inside ? -1e-3 * h : 1e-3 * h;
                           next[i] = float(target);
