@@ -1,6 +1,7 @@
 #include "apps/reconstruction.hpp"
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <atomic>
@@ -9,6 +10,7 @@
 #include <limits>
 #include <optional>
 #include <string>
+#include <unordered_map>
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
@@ -384,6 +386,221 @@ std::vector<float> mean_curvature_field(const NarrowBand& band) {
   return H;
 }
 
+// Topology control. A voxel's sign may change only where it is a simple point: flipping it
+// changes neither the number of components of the inside and outside voxel sets nor their
+// handles (3x3x3 test after Bertrand: one component of the inside and one of the outside in
+// the neighbourhood, each touching the voxel). The marching cubes resolve ambiguous faces by
+// the asymptotic decider, which follows neither fixed adjacency pair, so a flip is taken only
+// when it is simple for both (26, 6) and (6, 26). Why: a part thinner than the voxel (the
+// bunny's ears at the coarse levels, a thin sheet under noisy fits) otherwise breaks into
+// pieces or grows handles when the front crosses voxel centres on both of its sides; the
+// start shell fixed the topology, the flow and the snaps only move the surface.
+struct Neighbourhood {
+  std::array<std::array<int, 26>, 27> adj26{};
+  std::array<int, 27> n26{};
+  std::array<std::array<int, 6>, 27> adj6{};
+  std::array<int, 27> n6{};
+  Neighbourhood() {
+    for (int a = 0; a < 27; ++a) {
+      const int ax = a % 3, ay = (a / 3) % 3, az = a / 9;
+      for (int b = 0; b < 27; ++b) {
+        if (b == a) continue;
+        const int dx = std::abs(b % 3 - ax), dy = std::abs((b / 3) % 3 - ay), dz = std::abs(b / 9 - az);
+        if (std::max({dx, dy, dz}) > 1) continue;
+        adj26[a][n26[a]++] = b;
+        if (dx + dy + dz == 1) adj6[a][n6[a]++] = b;
+      }
+    }
+  }
+};
+
+// Components of `set` (bit per neighbourhood index, centre 13 excluded) under 26- or
+// 6-adjacency; for 6-adjacency only voxels of the 18-neighbourhood count, and only the
+// components holding a face neighbour of the centre.
+int neighbourhood_components(std::uint32_t set, bool six) {
+  static const Neighbourhood nb;
+  set &= ~(1u << 13);
+  if (six) {
+    for (int a = 0; a < 27; ++a) {
+      const int dx = std::abs(a % 3 - 1), dy = std::abs((a / 3) % 3 - 1), dz = std::abs(a / 9 - 1);
+      if (dx + dy + dz == 3) set &= ~(1u << a);  // corners: not in the 18-neighbourhood
+    }
+  }
+  int count = 0;
+  std::uint32_t seen = 0;
+  std::array<int, 27> stack{};
+  for (int start = 0; start < 27; ++start) {
+    if (!((set >> start) & 1u) || ((seen >> start) & 1u)) continue;
+    if (six && !(start == 4 || start == 10 || start == 12 || start == 14 || start == 16 || start == 22)) continue;
+    ++count;
+    int top = 0;
+    stack[std::size_t(top++)] = start;
+    seen |= 1u << start;
+    while (top > 0) {
+      const int a = stack[std::size_t(--top)];
+      const int n = six ? nb.n6[std::size_t(a)] : nb.n26[std::size_t(a)];
+      for (int k = 0; k < n; ++k) {
+        const int b = six ? nb.adj6[std::size_t(a)][std::size_t(k)] : nb.adj26[std::size_t(a)][std::size_t(k)];
+        if (((set >> b) & 1u) && !((seen >> b) & 1u)) {
+          seen |= 1u << b;
+          stack[std::size_t(top++)] = b;
+        }
+      }
+    }
+  }
+  return count;
+}
+
+// `inside`: bit per neighbourhood index (dz + 1) 9 + (dy + 1) 3 + dx + 1.
+bool simple_voxel(std::uint32_t inside) {
+  const std::uint32_t outside = ~inside & ((1u << 27) - 1u);
+  return neighbourhood_components(inside, false) == 1 && neighbourhood_components(outside, true) == 1 &&
+         neighbourhood_components(inside, true) == 1 && neighbourhood_components(outside, false) == 1;
+}
+
+// Whether one of the 12 faces through the centre voxel (sign `centre`, neighbours `inside`)
+// has alternating signs: the marching cubes decide those by value (asymptotic decider), so
+// a flip that makes or unmakes one is not covered by the fixed-adjacency simple test.
+bool ambiguous_face_at_centre(std::uint32_t inside, bool centre) {
+  auto in = [&](int dx, int dy, int dz) {
+    return (dx | dy | dz) == 0 ? centre : bool((inside >> ((dz + 1) * 9 + (dy + 1) * 3 + dx + 1)) & 1u);
+  };
+  static constexpr int kPlanes[3][2][3] = {{{1, 0, 0}, {0, 1, 0}}, {{1, 0, 0}, {0, 0, 1}}, {{0, 1, 0}, {0, 0, 1}}};
+  for (const auto& plane : kPlanes)
+    for (int sa = -1; sa <= 1; sa += 2)
+      for (int sb = -1; sb <= 1; sb += 2) {
+        const int ax = sa * plane[0][0], ay = sa * plane[0][1], az = sa * plane[0][2];
+        const int bx = sb * plane[1][0], by = sb * plane[1][1], bz = sb * plane[1][2];
+        const bool a = in(ax, ay, az), b = in(bx, by, bz), d = in(ax + bx, ay + by, az + bz);
+        if (d == centre && a != centre && b != centre) return true;
+      }
+  return false;
+}
+
+// Keeps the topology of `before`'s inside set: `values` (active-voxel order of `after`, a band
+// on the same grid) may flip the sign of a voxel of `before` only where the flip is simple;
+// flips are taken one by one in brick order, repeated while some become simple, and the
+// others keep their old sign at +-eps. Serial (the flips are few, all at the front):
+// deterministic. Returns the number of flips refused.
+std::uint64_t keep_topology(const NarrowBand& before, const NarrowBand& after, std::vector<float>& values, double eps) {
+  struct Candidate {
+    Coord c;
+    std::size_t slot;
+  };
+  std::vector<Candidate> pending;
+  BandAccessor old_acc(before);
+  for (std::uint32_t b = 0; b < after.brick_count(); ++b) {
+    std::size_t slot = after.bricks()[b].value_offset;
+    after.for_each_active_in_brick(b, [&](const Coord& c, float) {
+      const std::size_t i = slot++;
+      if ((values[i] < 0.0f) != old_acc.is_inside(c)) pending.push_back({c, i});
+    });
+  }
+  if (pending.empty()) return 0;
+  auto key = [](const Coord& c) {
+    return (std::uint64_t(std::uint32_t(c.x) & 0x1fffffu) << 42) | (std::uint64_t(std::uint32_t(c.y) & 0x1fffffu) << 21) |
+           std::uint64_t(std::uint32_t(c.z) & 0x1fffffu);
+  };
+  std::unordered_map<std::uint64_t, bool> flipped;  // current sign of the voxels flipped so far
+  auto inside_now = [&](const Coord& c) {
+    const auto it = flipped.find(key(c));
+    return it != flipped.end() ? it->second : old_acc.is_inside(c);
+  };
+  bool progress = true;
+  while (progress && !pending.empty()) {
+    progress = false;
+    std::vector<Candidate> rest;
+    for (const Candidate& cand : pending) {
+      std::uint32_t inside = 0;
+      for (int dz = -1; dz <= 1; ++dz)
+        for (int dy = -1; dy <= 1; ++dy)
+          for (int dx = -1; dx <= 1; ++dx)
+            if ((dx | dy | dz) != 0 && inside_now(cand.c + Coord{dx, dy, dz}))
+              inside |= 1u << ((dz + 1) * 9 + (dy + 1) * 3 + dx + 1);
+      const bool to_inside = values[cand.slot] < 0.0f;
+      if (simple_voxel(inside) && !ambiguous_face_at_centre(inside, !to_inside) && !ambiguous_face_at_centre(inside, to_inside)) {
+        flipped[key(cand.c)] = values[cand.slot] < 0.0f;
+        progress = true;
+      } else {
+        rest.push_back(cand);
+      }
+    }
+    pending.swap(rest);
+  }
+  for (const Candidate& cand : pending) values[cand.slot] = float(old_acc.is_inside(cand.c) ? -eps : eps);
+  return pending.size();
+}
+
+// The marching cubes join or separate the two inside corners of an ambiguous face (signs
+// alternating round it) by the asymptotic decider: joined when v00 v11 > v10 v01 for the
+// inside diagonal (00, 11). A change of values without any sign change can therefore add a
+// handle or cut a thin part (measured: the snaps grew the bunny's ear handles with every
+// sign change simple). So where a face is ambiguous with the same signs before and after,
+// its decision must not change: the four corners of a face whose decision changed go back
+// to their values in `before` (same signs), repeated until no face changes (each round only
+// restores old values, so it ends). Returns the number of voxels restored. Serial over the
+// few ambiguous faces: deterministic.
+std::uint64_t keep_face_decisions(const NarrowBand& before, const NarrowBand& after, std::vector<float>& values) {
+  BandAccessor old_acc(before), acc(after);
+  auto slot_of = [&](const Coord& c) -> std::size_t {
+    const std::uint32_t b = acc.locate(brick_of(c));
+    if (b == kNoBrick) return std::size_t(-1);
+    const Brick& br = after.bricks()[b];
+    const int n = local_index(c);
+    return br.active.test(n) ? br.value_offset + br.slot(n) : std::size_t(-1);
+  };
+  static constexpr Coord kAxes[3][2] = {{{1, 0, 0}, {0, 1, 0}}, {{1, 0, 0}, {0, 0, 1}}, {{0, 1, 0}, {0, 0, 1}}};
+  // joined(): +1 inside diagonal joined, -1 separated, 0 not ambiguous.
+  auto decision = [](double v00, double v10, double v11, double v01) {
+    const bool i00 = v00 < 0, i10 = v10 < 0, i11 = v11 < 0, i01 = v01 < 0;
+    if (i00 != i11 || i10 != i01 || i00 == i10) return 0;
+    const double inside = i00 ? v00 * v11 : v10 * v01, outside = i00 ? v10 * v01 : v00 * v11;
+    return inside > outside ? 1 : -1;
+  };
+  struct Face {
+    std::array<std::size_t, 4> slot;
+    std::array<double, 4> old;
+    int old_decision;
+  };
+  std::vector<Face> faces;
+  for (std::uint32_t b = 0; b < after.brick_count(); ++b) {
+    after.for_each_active_in_brick(b, [&](const Coord& c, float) {
+      for (const auto& axes : kAxes) {
+        const std::array<Coord, 4> corner{c, c + axes[0], c + axes[0] + axes[1], c + axes[1]};
+        Face f;
+        bool ok = true;
+        for (int k = 0; k < 4 && ok; ++k) {
+          f.slot[std::size_t(k)] = slot_of(corner[std::size_t(k)]);
+          const std::optional<float> v = old_acc.probe(corner[std::size_t(k)]);
+          ok = f.slot[std::size_t(k)] != std::size_t(-1) && v.has_value();
+          if (ok) f.old[std::size_t(k)] = double(*v);
+        }
+        if (!ok) continue;
+        f.old_decision = decision(f.old[0], f.old[1], f.old[2], f.old[3]);
+        if (f.old_decision != 0) faces.push_back(f);
+      }
+    });
+  }
+  std::uint64_t restored = 0;
+  for (bool changed = true; changed;) {
+    changed = false;
+    for (const Face& f : faces) {
+      const std::array<double, 4> v{double(values[f.slot[0]]), double(values[f.slot[1]]), double(values[f.slot[2]]),
+                                    double(values[f.slot[3]])};
+      const int d = decision(v[0], v[1], v[2], v[3]);
+      if (d == 0 || d == f.old_decision) continue;  // signs changed (a simple flip), or same decision
+      for (int k = 0; k < 4; ++k) {
+        if (values[f.slot[std::size_t(k)]] != float(f.old[std::size_t(k)])) {
+          values[f.slot[std::size_t(k)]] = float(f.old[std::size_t(k)]);
+          ++restored;
+          changed = true;
+        }
+      }
+    }
+  }
+  return restored;
+}
+
 struct SnapPass {
   double mean_change = 0.0;     // voxels, over the snapped voxels
   double noise = 0.0;           // mean robust spread of the fits, voxels
@@ -391,6 +608,7 @@ struct SnapPass {
   bool clean = false;           // the height fits' offsets were used, unaveraged
   std::uint64_t voxels = 0;     // snapped (fits computed)
   std::uint64_t height_fits = 0;  // of them with a usable height fit
+  std::uint64_t refused = 0;    // sign changes refused (not simple: they would change the topology)
 };
 
 // One snap pass (see the header): every voxel with |u| < window h takes the signed offset s
@@ -518,8 +736,11 @@ SnapPass snap_to_fits(NarrowBand& band, const PointIndex& index, int neighbors, 
                         });
                       }
                     });
+  const std::uint64_t refused = keep_topology(band, band, next, 1e-3 * h);
+  keep_face_decisions(band, band, next);
   band.swap_values(next);
   SnapPass pass;
+  pass.refused = refused;
   pass.noise = sigma;
   pass.smoothing = smoothing;
   pass.clean = clean;
@@ -596,23 +817,59 @@ ReconstructionResult reconstruct_surface(const std::vector<Vec3d>& input, const 
       MotionMeter meter;
       evolve::EvolutionOptions ev;
       ev.speed = fit_speed(cache, fits, index, o.neighbors, o.curvature_weight, meter);
-      ev.steps = o.max_steps;
+      ev.steps = 1;
       ev.drift_tolerance = 0.1;  // the speed is constant along normals near the data: rare
       ev.progress.cancel = o.progress.cancel;
-      ev.stop_when = [&](const evolve::StepInfo& si) {
-        stage.last_change = meter.take_mean() * si.dt / h;
-        o.progress.step(0.5 * double(si.step) / o.max_steps / levels, "reconstruct");
-        return stage.last_change < o.tolerance;
-      };
+      // One step per evolve call: between steps, sign changes that are not simple are
+      // refused and ambiguous faces keep their decision (keep_topology): the start shell's
+      // topology is the result's (a part thinner than a coarse voxel, the bunny's ears,
+      // otherwise broke off or grew handles depending on the sample set).
       const auto t_flow = Clock::now();
-      evolve::EvolutionResult r = evolve::evolve(band, ev);
+      for (int step = 1; step <= o.max_steps; ++step) {
+        evolve::EvolutionResult r = evolve::evolve(band, ev);
+        if (r.stop == evolve::StopReason::Cancelled) throw Error(ErrorCode::Cancelled, "reconstruct", "operation cancelled");
+        if (r.stop == evolve::StopReason::NonFinite) throw Error(ErrorCode::NonFinite, "reconstruct", r.message);
+        stage.seconds_redistance += r.seconds.redistance;
+        std::vector<float> values(r.band.values().begin(), r.band.values().end());
+        const std::uint64_t refused = keep_topology(band, r.band, values, 1e-3 * h);
+        keep_face_decisions(band, r.band, values);
+        r.band.swap_values(values);
+        if (refused > 0) {
+          // Refused voxels hold the front where the band upkeep had moved on: redistance on
+          // the domain grown by one voxel, as after a snap.
+          stage.refused_flips += refused;
+          const auto t_redistance = Clock::now();
+          RedistanceOptions redo;
+          redo.half_width = W;
+          redo.progress = o.progress;
+          r.band = redistance(reframed(r.band, {}, W - 1.0), redo).band;
+          stage.seconds_redistance += seconds_since(t_redistance);
+        }
+        // Convergence: the mean motion of the voxels within one voxel of the front, measured
+        // on the values after the topology control (the speed's own |beta| stays high where a
+        // refused voxel pins the front).
+        double moved = 0.0;
+        std::uint64_t near = 0;
+        {
+          BandAccessor old_acc(band);
+          for (std::uint32_t b = 0; b < r.band.brick_count(); ++b)
+            r.band.for_each_active_in_brick(b, [&](const Coord& c, float u) {
+              if (!(std::abs(double(u)) < h)) return;
+              const std::optional<float> was = old_acc.probe(c);
+              if (!was) return;
+              moved += std::min(std::abs(double(u) - double(*was)), h);
+              ++near;
+            });
+        }
+        meter.take_mean();
+        band = std::move(r.band);
+        stage.steps = step;
+        stage.last_change = near > 0 ? moved / double(near) / h : 0.0;
+        o.progress.step(0.5 * double(step) / o.max_steps / levels, "reconstruct");
+        if (stage.last_change < o.tolerance) break;
+      }
       stage.seconds_flow = seconds_since(t_flow);
-      if (r.stop == evolve::StopReason::Cancelled) throw Error(ErrorCode::Cancelled, "reconstruct", "operation cancelled");
-      if (r.stop == evolve::StopReason::NonFinite) throw Error(ErrorCode::NonFinite, "reconstruct", r.message);
-      stage.steps = r.steps;
       stage.converged = stage.last_change < o.tolerance;
-      stage.seconds_redistance = r.seconds.redistance;
-      band = std::move(r.band);
     }
     if (level > 0 || levels == 1) {
       // The snap (on a single level: after the flow, with its own curvature).
@@ -633,6 +890,7 @@ ReconstructionResult reconstruct_surface(const std::vector<Vec3d>& input, const 
         refine = snapped.clean;
         stage.second_order = snapped.clean;
         stage.height_fits += snapped.height_fits;
+        stage.refused_flips += snapped.refused;
         stage.seconds_fit += seconds_since(t_fit);
         stage.fit_voxels += snapped.voxels;
         stage.last_change = snapped.mean_change;
@@ -667,6 +925,16 @@ ReconstructionResult reconstruct_surface(const std::vector<Vec3d>& input, const 
                   static_cast<unsigned long long>(stage.height_fits),
                   stage.seconds_start, stage.seconds_fit, stage.seconds_flow, stage.seconds_redistance, stage.seconds);
     log(line);
+    if (o.log) {
+      // Debug aid: the topology of this level's zero level.
+      MarchingCubesOptions mc;
+      mc.progress = o.progress;
+      const MeshMeasures m = measure_mesh(marching_cubes(band, mc).mesh);
+      std::snprintf(line, sizeof line, "level %d: genus %g, components %llu, watertight %s, %llu sign changes refused", level, m.genus,
+                    static_cast<unsigned long long>(m.components), m.watertight ? "yes" : "no",
+                    static_cast<unsigned long long>(stage.refused_flips));
+      log(line);
+    }
     result.steps += stage.steps;
     result.stages.push_back(stage);
   }

@@ -7,7 +7,10 @@
 // watertight, genus, seconds. --quick: the knot, 20k clean points, resolution 96, no Poisson.
 // Development switches (any order after the program name): --ours (no Poisson), --mesh NAME
 // (knot.off or bunny00.off), --points N, --noise F (fraction of the diagonal): one case;
-// --log: the reconstruction's per-level lines on stderr.
+// --log: the reconstruction's per-level lines on stderr; --seeds A B: the sampling seeds A..B
+// (default 5 only); --levels L, --neighbors K: reconstruction options; --topology: no
+// distances, only watertight / genus / components per case (fast sample-set sweeps).
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdio>
@@ -60,6 +63,9 @@ int main(int argc, char** argv) {
   std::string only_mesh;
   long only_points = -1;
   double only_noise = -1.0;
+  unsigned long seed_first = 5, seed_last = 5;
+  int levels = 0, neighbors = 0;
+  bool topology_only = false;
   for (int a = 1; a < argc; ++a) {
     const std::string arg = argv[a];
     if (arg == "--ours") ours_only = true;
@@ -67,6 +73,13 @@ int main(int argc, char** argv) {
     if (a + 1 < argc && arg == "--mesh") only_mesh = argv[a + 1];
     if (a + 1 < argc && arg == "--points") only_points = std::atol(argv[a + 1]);
     if (a + 1 < argc && arg == "--noise") only_noise = std::atof(argv[a + 1]);
+    if (a + 2 < argc && arg == "--seeds") {
+      seed_first = std::strtoul(argv[a + 1], nullptr, 10);
+      seed_last = std::max(seed_first, std::strtoul(argv[a + 2], nullptr, 10));
+    }
+    if (a + 1 < argc && arg == "--levels") levels = std::atoi(argv[a + 1]);
+    if (a + 1 < argc && arg == "--neighbors") neighbors = std::atoi(argv[a + 1]);
+    if (arg == "--topology") topology_only = true;
   }
   return bench::run_bench("bench_reconstruct", "a reconstruction is not watertight", [&] {
     bool ok = true;
@@ -87,14 +100,17 @@ int main(int argc, char** argv) {
           if (quick && (count != 20000 || noise > 0)) continue;
           if (only_points >= 0 && std::size_t(only_points) != count) continue;
           if (only_noise >= 0.0 && std::abs(only_noise - noise) > 1e-12) continue;
+          for (unsigned long seed = seed_first; seed <= seed_last; ++seed) {
           apps::SurfaceSampleOptions ps;
           ps.count = count;
           ps.noise = noise * diag;
-          ps.seed = 5;
+          ps.seed = seed;
           const std::vector<Vec3d> points = apps::sample_mesh_surface(truth, ps);
           apps::ReconstructionOptions o;
           o.resolution = quick ? 96 : 256;
           if (noise > 0) o.neighbors = 24;
+          if (neighbors > 0) o.neighbors = neighbors;
+          if (levels > 0) o.levels = levels;
           if (log_stages) o.log = [](const std::string& line) { std::fprintf(stderr, "  %s\n", line.c_str()); };
           const auto t0 = std::chrono::steady_clock::now();
           const apps::ReconstructionResult r = apps::reconstruct_surface(points, o);
@@ -106,6 +122,15 @@ int main(int argc, char** argv) {
                         row.watertight ? "yes" : "no", row.genus, row.seconds);
             std::fflush(stdout);
           };
+          if (topology_only) {
+            std::printf("%-10s %7zu %6.3f%% | seed %lu: watertight %s, genus %g, components %llu, %.2f s\n", name, count,
+                        noise * 100, seed, r.measures.watertight ? "yes" : "no", r.measures.genus,
+                        static_cast<unsigned long long>(r.measures.components), ours_s);
+            std::fflush(stdout);
+            ok = ok && r.measures.watertight;
+            continue;
+          }
+          if (seed_last > seed_first) std::printf("seed %lu\n", seed);
           const Row ours = score(truth, truth_samples, r.mesh, ours_s);
           print("levelset", ours);
           ok = ok && ours.watertight;
@@ -133,6 +158,7 @@ int main(int argc, char** argv) {
           MeshReadOptions mo;
           const TriangleMesh poisson = read_mesh(ply, mo).mesh;
           print("poisson", score(truth, truth_samples, poisson, json["seconds"].get<double>()));
+          }
         }
       }
     }
