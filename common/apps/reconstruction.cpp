@@ -482,7 +482,8 @@ bool ambiguous_face_at_centre(std::uint32_t inside, bool centre) {
 // flips are taken one by one in brick order, repeated while some become simple, and the
 // others keep their old sign at +-eps. Serial (the flips are few, all at the front):
 // deterministic. Returns the number of flips refused.
-std::uint64_t keep_topology(const NarrowBand& before, const NarrowBand& after, std::vector<float>& values, double eps) {
+std::uint64_t keep_topology(const NarrowBand& before, const NarrowBand& after, std::vector<float>& values, double eps,
+                            const PointIndex* index = nullptr, double free_distance = 0.0) {
   struct Candidate {
     Coord c;
     std::size_t slot;
@@ -518,7 +519,8 @@ std::uint64_t keep_topology(const NarrowBand& before, const NarrowBand& after, s
             if ((dx | dy | dz) != 0 && inside_now(cand.c + Coord{dx, dy, dz}))
               inside |= 1u << ((dz + 1) * 9 + (dy + 1) * 3 + dx + 1);
       const bool to_inside = values[cand.slot] < 0.0f;
-      if (simple_voxel(inside) && !ambiguous_face_at_centre(inside, !to_inside) && !ambiguous_face_at_centre(inside, to_inside)) {
+      if ((simple_voxel(inside) && !ambiguous_face_at_centre(inside, !to_inside) && !ambiguous_face_at_centre(inside, to_inside)) ||
+          (index != nullptr && index->nearest(after.world(cand.c)).distance > free_distance)) {
         flipped[key(cand.c)] = values[cand.slot] < 0.0f;
         progress = true;
       } else {
@@ -615,7 +617,7 @@ struct SnapPass {
 // of its local fit along the level set's normal, moved by at most one voxel. Per-brick sums
 // added in brick order (deterministic).
 SnapPass snap_to_fits(NarrowBand& band, const PointIndex& index, int neighbors, double window, const NarrowBand& coarse,
-                      const std::vector<float>& coarse_curvature, double h_final, const ProgressHook& progress) {
+                      const std::vector<float>& coarse_curvature, double h_final, bool guard, const ProgressHook& progress) {
   const double h = band.voxel_size();
   const bool same_grid = coarse.voxel_size() == h;  // a single level: its own curvature
   const float unset = std::numeric_limits<float>::quiet_NaN();
@@ -736,8 +738,8 @@ SnapPass snap_to_fits(NarrowBand& band, const PointIndex& index, int neighbors, 
                         });
                       }
                     });
-  const std::uint64_t refused = keep_topology(band, band, next, 1e-3 * h);
-  keep_face_decisions(band, band, next);
+  const std::uint64_t refused = guard ? keep_topology(band, band, next, 1e-3 * h) : 0;
+  if (guard) keep_face_decisions(band, band, next);
   band.swap_values(next);
   SnapPass pass;
   pass.refused = refused;
@@ -825,13 +827,28 @@ ReconstructionResult reconstruct_surface(const std::vector<Vec3d>& input, const 
       // topology is the result's (a part thinner than a coarse voxel, the bunny's ears,
       // otherwise broke off or grew handles depending on the sample set).
       const auto t_flow = Clock::now();
-      for (int step = 1; step <= o.max_steps; ++step) {
+      if (!o.guard_flow) {
+        // Unguarded: one evolve call, stopped by the mean |beta| near the front.
+        ev.steps = o.max_steps;
+        ev.stop_when = [&](const evolve::StepInfo& si) {
+          stage.last_change = meter.take_mean() * si.dt / h;
+          o.progress.step(0.5 * double(si.step) / o.max_steps / levels, "reconstruct");
+          return stage.last_change < o.tolerance;
+        };
+        evolve::EvolutionResult r = evolve::evolve(band, ev);
+        if (r.stop == evolve::StopReason::Cancelled) throw Error(ErrorCode::Cancelled, "reconstruct", "operation cancelled");
+        if (r.stop == evolve::StopReason::NonFinite) throw Error(ErrorCode::NonFinite, "reconstruct", r.message);
+        stage.steps = r.steps;
+        stage.seconds_redistance = r.seconds.redistance;
+        band = std::move(r.band);
+      }
+      for (int step = 1; o.guard_flow && step <= o.max_steps; ++step) {
         evolve::EvolutionResult r = evolve::evolve(band, ev);
         if (r.stop == evolve::StopReason::Cancelled) throw Error(ErrorCode::Cancelled, "reconstruct", "operation cancelled");
         if (r.stop == evolve::StopReason::NonFinite) throw Error(ErrorCode::NonFinite, "reconstruct", r.message);
         stage.seconds_redistance += r.seconds.redistance;
         std::vector<float> values(r.band.values().begin(), r.band.values().end());
-        const std::uint64_t refused = keep_topology(band, r.band, values, 1e-3 * h);
+        const std::uint64_t refused = keep_topology(band, r.band, values, 1e-3 * h, &index, o.free_distance * h);
         keep_face_decisions(band, r.band, values);
         r.band.swap_values(values);
         if (refused > 0) {
@@ -885,7 +902,7 @@ ReconstructionResult reconstruct_surface(const std::vector<Vec3d>& input, const 
       for (int pass = 0; pass < passes; ++pass) {
         const auto t_fit = Clock::now();
         const SnapPass snapped =
-            snap_to_fits(band, index, o.neighbors, refine ? kRefineWindow : kSnapWindow, coarse, coarse_curvature, h_final, o.progress);
+            snap_to_fits(band, index, o.neighbors, refine ? kRefineWindow : kSnapWindow, coarse, coarse_curvature, h_final, o.guard_snaps, o.progress);
         if (pass == 0 && level == levels - 1 && snapped.clean) passes = std::max(passes, o.clean_final_passes);
         refine = snapped.clean;
         stage.second_order = snapped.clean;

@@ -104,6 +104,9 @@ struct ReconstructionOptions {
   int snap_passes = 1;          // per finer level (noisy data: more drift, 1 measured best)
   int clean_final_passes = 2;   // final level, clean data (second-order snaps): at least this many
   double tolerance = 0.01;      // voxels: flow: mean front motion per step; snap: mean change
+  bool guard_flow = true;        // coarsest flow: refuse sign changes that change the topology (slower)
+  bool guard_snaps = true;      // snaps: the same
+  double free_distance = 1.0;   // flow guard: topology may change where the nearest point is farther (coarse voxels)
   int max_resolution = 4096;    // cap on the final grid's longest side (voxels)
   ProgressHook progress;
   std::function<void(const std::string&)> log;  // progress lines; empty: none

@@ -66,6 +66,8 @@ int main(int argc, char** argv) {
   unsigned long seed_first = 5, seed_last = 5;
   int levels = 0, neighbors = 0;
   bool topology_only = false;
+  bool guard_flow = true, guard_snaps = true;
+  double free_distance = -1.0;
   for (int a = 1; a < argc; ++a) {
     const std::string arg = argv[a];
     if (arg == "--ours") ours_only = true;
@@ -80,6 +82,9 @@ int main(int argc, char** argv) {
     if (a + 1 < argc && arg == "--levels") levels = std::atoi(argv[a + 1]);
     if (a + 1 < argc && arg == "--neighbors") neighbors = std::atoi(argv[a + 1]);
     if (arg == "--topology") topology_only = true;
+    if (arg == "--no-guard-flow") guard_flow = false;
+    if (arg == "--no-guard-snaps") guard_snaps = false;
+    if (a + 1 < argc && arg == "--free-distance") free_distance = std::atof(argv[a + 1]);
   }
   return bench::run_bench("bench_reconstruct", "a reconstruction is not watertight", [&] {
     bool ok = true;
@@ -111,6 +116,9 @@ int main(int argc, char** argv) {
           if (noise > 0) o.neighbors = 24;
           if (neighbors > 0) o.neighbors = neighbors;
           if (levels > 0) o.levels = levels;
+          o.guard_flow = guard_flow;
+          o.guard_snaps = guard_snaps;
+          if (free_distance >= 0.0) o.free_distance = free_distance;
           if (log_stages) o.log = [](const std::string& line) { std::fprintf(stderr, "  %s\n", line.c_str()); };
           const auto t0 = std::chrono::steady_clock::now();
           const apps::ReconstructionResult r = apps::reconstruct_surface(points, o);
