@@ -26,7 +26,7 @@ namespace levelset::jobs {
 void run_reconstruct_job(JobContext& ctx) {
   const config::Set& in = ctx.section("input", {"points", "sample", "sample_mesh", "count", "noise", "seed"});
   const config::Set& s = ctx.section("reconstruct", {"levels", "neighbors", "curvature_weight", "max_steps", "snap_passes",
-                                                     "clean_final_passes", "tolerance", "shell_offset", "accuracy_samples"});
+                                                     "clean_final_passes", "guard_flow", "guard_snaps", "free_distance", "tolerance", "shell_offset", "accuracy_samples"});
   const int given = (ctx.has(in, "points") ? 1 : 0) + (ctx.has(in, "sample") ? 1 : 0) + (ctx.has(in, "sample_mesh") ? 1 : 0);
   if (given != 1)
     throw Error(ErrorCode::InvalidArgument, ctx.options().name,
@@ -73,6 +73,9 @@ void run_reconstruct_job(JobContext& ctx) {
   o.max_steps = ctx.integer(s, "max_steps", o.max_steps, 1, 100000);
   o.snap_passes = ctx.integer(s, "snap_passes", o.snap_passes, 0, 16);
   o.clean_final_passes = ctx.integer(s, "clean_final_passes", o.clean_final_passes, 0, 16);
+  o.guard_flow = ctx.flag(s, "guard_flow", o.guard_flow);
+  o.guard_snaps = ctx.flag(s, "guard_snaps", o.guard_snaps);
+  o.free_distance = ctx.number(s, "free_distance", o.free_distance, 0.0, 100.0);
   o.tolerance = ctx.number(s, "tolerance", o.tolerance, 1e-9, 10.0);
   o.shell_offset = ctx.number(s, "shell_offset", o.shell_offset, 1.0, 16.0);
   o.progress = ctx.options().progress;
