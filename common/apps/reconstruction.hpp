@@ -123,6 +123,7 @@ struct ReconstructionStage {
   bool second_order = false;    // snap: clean data: the height fits' offsets, unaveraged (last pass)
   std::uint64_t height_fits = 0;  // snap: fits whose height fit was usable (all passes)
   std::uint64_t refused_flips = 0;  // sign changes refused as not simple (topology kept), all steps / passes
+  std::uint64_t dropped_components = 0;  // coarsest level: components without data turned to the other sign
   std::uint64_t active_voxels = 0;
   std::uint64_t fit_voxels = 0; // local fits computed (cache, or snapped voxels of all passes)
   double seconds = 0.0;         // whole level
