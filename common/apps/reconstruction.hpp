@@ -122,6 +122,7 @@ struct ReconstructionStage {
   int smoothing = 0;            // snap: extra smoothing passes of the offsets it chose
   bool second_order = false;    // snap: clean data: the height fits' offsets, unaveraged (last pass)
   std::uint64_t height_fits = 0;  // snap: fits whose height fit was usable (all passes)
+  int height_neighbors = 0;     // snap: points per height fit (last pass)
   std::uint64_t refused_flips = 0;  // sign changes refused as not simple (topology kept), all steps / passes
   std::uint64_t dropped_components = 0;  // coarsest level: components without data turned to the other sign
   std::uint64_t active_voxels = 0;
