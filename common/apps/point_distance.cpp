@@ -79,6 +79,23 @@ void PointIndex::within(const Vec3d& x, double radius, std::vector<std::pair<std
   tree_->tree.radiusSearch(q, radius * radius, out, nanoflann::SearchParams(32, 0.0f, false));
 }
 
+double sample_gap(const PointIndex& index, int k, double quantile, std::size_t samples) {
+  const std::size_t n = index.size();
+  if (n < 2 || samples == 0) return 0.0;
+  const int want = std::clamp(k + 1, 2, std::min(kMaxNeighbors, int(n)));  // the point itself is its own nearest
+  const std::size_t stride = std::max<std::size_t>(1, n / samples);
+  std::array<std::uint32_t, kMaxNeighbors> idx{};
+  std::array<double, kMaxNeighbors> d2{};
+  std::vector<double> gaps;
+  for (std::size_t i = 0; i < n; i += stride) {
+    const int got = index.k_nearest(index.points()[i], want, idx.data(), d2.data());
+    gaps.push_back(std::sqrt(d2[std::size_t(got - 1)]));
+  }
+  const std::size_t at = std::min(gaps.size() - 1, std::size_t(std::clamp(quantile, 0.0, 1.0) * double(gaps.size() - 1)));
+  std::nth_element(gaps.begin(), gaps.begin() + std::ptrdiff_t(at), gaps.end());
+  return gaps[at];
+}
+
 PointDistanceResult point_distance(const PointIndex& index, std::span<const Vec3d> queries,
                                    const PointDistanceOptions& options) {
   const auto t0 = std::chrono::steady_clock::now();

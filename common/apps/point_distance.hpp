@@ -20,6 +20,10 @@
 // point_fit_field: the LocalFit of every active voxel of `where` (a NarrowBand used as the
 //   set of voxels), in the band's value order; O(voxels * k log N), TBB over bricks,
 //   identical for any thread count. Progress per brick batch, cancellable.
+// sample_gap: the q-quantile over up to `samples` points (every (N / samples)-th, so the result
+//   is deterministic) of the distance from a point to its k-th nearest other point: the
+//   radius of the holes a sampling leaves, e.g. what an offset surface of the points must
+//   close. O(samples * k log N), serial.
 // Units: world. Errors: Error{InvalidArgument} for an empty point set, k < 1 or k > 256;
 //   Error{NonFinite} for a non-finite point; Error{Cancelled} through the hook.
 #pragma once
@@ -62,6 +66,8 @@ class PointIndex {
   std::vector<Vec3d> points_;
   std::unique_ptr<Tree> tree_;
 };
+
+double sample_gap(const PointIndex& index, int k, double quantile, std::size_t samples);
 
 struct PointDistanceOptions {
   ProgressHook progress;

@@ -106,6 +106,7 @@ constexpr double kFitWindow = 1.0;
 // fraction of them is a stray (drop_unsupported_components).
 constexpr double kMinSupport = 0.5;
 constexpr double kSupportDistance = 1.5;
+constexpr double kGapClosing = 1.5;
 
 double seconds_since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
 
@@ -915,7 +916,12 @@ ReconstructionResult reconstruct_surface(const std::vector<Vec3d>& input, const 
   int levels = o.levels;
   while (levels > 1 && longest / (h_final * std::ldexp(1.0, levels - 1)) < 24.0) --levels;
   const double h_coarse = h_final * std::ldexp(1.0, levels - 1);
-  const double pad = (o.shell_offset + W + 3.0) * h_coarse;
+  // The start shell closes holes between samples up to its offset: at least kGapClosing times
+  // the 90th percentile of the distance to the 8th nearest sample, or its flood fill leaks
+  // into the inside and the flow collapses onto the points from both sides.
+  const double gap = sample_gap(index, 8, 0.9, 4000);
+  const double shell_offset = std::min(16.0, std::max(o.shell_offset, kGapClosing * gap / h_coarse));
+  const double pad = (shell_offset + W + 3.0) * h_coarse;
   const Vec3d origin = local.min - Vec3d{pad, pad, pad};
 
   ReconstructionResult result;
@@ -930,7 +936,8 @@ ReconstructionResult reconstruct_surface(const std::vector<Vec3d>& input, const 
     stage.voxel_size = h;
     if (level == 0) {
       // The flow from the start shell.
-      band = start_shell(index, local, origin, h, o.shell_offset, W, o.progress);
+      band = start_shell(index, local, origin, h, shell_offset, W, o.progress);
+      stage.shell_offset = shell_offset;
       stage.seconds_start = seconds_since(t_level);
       // Cache of fits: the voxels within W + 2 of the start front.
       RedistanceOptions grow;
@@ -1091,9 +1098,9 @@ ReconstructionResult reconstruct_surface(const std::vector<Vec3d>& input, const 
     stage.active_voxels = band.active_voxel_count();
     stage.seconds = seconds_since(t_level);
     std::snprintf(line, sizeof line,
-                  "level %d: h %.4g, %s %d, change %.4f voxel, noise %.3f voxel, %s (%d points), smoothing %d, %llu voxels, %llu fits (%llu height); start %.3f s, "
+                  "level %d: h %.4g, shell offset %.2f voxel, %s %d, change %.4f voxel, noise %.3f voxel, %s (%d points), smoothing %d, %llu voxels, %llu fits (%llu height); start %.3f s, "
                   "fits %.3f s, flow %.3f s, redistance %.3f s, total %.3f s",
-                  level, h, level == 0 ? "flow steps" : "snap passes", stage.steps, stage.last_change, stage.noise,
+                  level, h, stage.shell_offset, level == 0 ? "flow steps" : "snap passes", stage.steps, stage.last_change, stage.noise,
                   stage.second_order ? "second order" : "plane fits", stage.height_neighbors, stage.smoothing,
                   static_cast<unsigned long long>(stage.active_voxels), static_cast<unsigned long long>(stage.fit_voxels),
                   static_cast<unsigned long long>(stage.height_fits),

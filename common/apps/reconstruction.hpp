@@ -8,13 +8,17 @@
 //   exact to ~1e-4 voxel), the final voxel size is h = L / (resolution - 2 (W + 2)) (L the
 //   longest side of the points' box: `resolution` voxels span the box padded by W + 2 on each
 //   side) or voxel_size; level l of `levels` uses h * 2^(levels - 1 - l).
-//   Start (coarsest level): the offset surface {d = shell_offset * h_c} of the unsigned
+//   Start (coarsest level): the offset surface {d = offset * h_c} of the unsigned
 //   distance d to the points, outer component only (flood fill from the grid's boundary over
 //   d > offset on a dense grid of the coarsest level; the cavity inside a closed shell is
 //   filled). Why this and not the bounding box the thesis starts from: the offset already
 //   follows concavities up to the offset radius, so the flow only has to travel ~offset
 //   voxels instead of carving deep concavities, and closing gaps up to 2 * offset * h_c
 //   between samples at the coarse level keeps the flood fill from leaking into the inside.
+//   offset = max(shell_offset, 1.5 g / h_c), g the 90th percentile of the distance from a
+//   sample to its 8th nearest (apps/point_distance.hpp sample_gap): with fewer levels or
+//   sparser points a fixed offset leaked (the bunny at 20k-35k points, levels = 2: the flow
+//   then pulled the shell onto the points from both sides and collapsed it).
 //   Coarsest level, a flow: u_t + beta |grad u| = 0 with (beta > 0 outward, H = k1 + k2)
 //     beta = -clamp(g (s - u) / h, -1, 1) - w * min(d, h) * H,   g = 3,
 //   s = the signed distance of the voxel to the surface the k nearest points sample along the
@@ -116,6 +120,7 @@ struct ReconstructionStage {
   int level = 0;                // 0 = coarsest (flow), then snaps
   double voxel_size = 0.0;
   int steps = 0;                // flow steps, or snap passes
+  double shell_offset = 0.0;    // coarsest level: the start shell's offset (voxels; raised to close the samples' gaps)
   bool converged = false;       // tolerance reached
   double last_change = 0.0;     // voxels: flow: mean front motion per step; snap: mean change
   double noise = 0.0;           // snap: the fits' mean robust spread (noise estimate), voxels

@@ -37,10 +37,12 @@ nlohmann::json shape_json(const apps::ShapeMeasures& m) {
 nlohmann::json stages_json(const std::vector<apps::ReconstructionStage>& stages) {
   nlohmann::json levels = nlohmann::json::array();
   for (const apps::ReconstructionStage& s : stages)
-    levels.push_back({{"level", s.level},        {"voxel_size", s.voxel_size}, {"steps", s.steps},
+    levels.push_back({{"level", s.level},        {"voxel_size", s.voxel_size}, {"steps", s.steps}, {"shell_offset", s.shell_offset},
                       {"converged", s.converged}, {"last_change", s.last_change}, {"noise", s.noise},
                       {"smoothing", s.smoothing},  {"second_order", s.second_order},
-                      {"height_fits", s.height_fits}, {"active_voxels", s.active_voxels},
+                      {"height_fits", s.height_fits}, {"height_neighbors", s.height_neighbors},
+                      {"refused_flips", s.refused_flips}, {"dropped_components", s.dropped_components},
+                      {"active_voxels", s.active_voxels},
                       {"fit_voxels", s.fit_voxels}, {"seconds", s.seconds},
                       {"seconds_start", s.seconds_start}, {"seconds_fit", s.seconds_fit},
                       {"seconds_flow", s.seconds_flow}, {"seconds_redistance", s.seconds_redistance}});

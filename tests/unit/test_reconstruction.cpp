@@ -194,6 +194,37 @@ TEST(Reconstruction, SphereIsSubVoxelAccurate) {
   EXPECT_GT(r.stages.back().height_fits, 0u);
 }
 
+TEST(PointDistance, SampleGapOfALatticeIsTheEighthNeighbourDistance) {
+  // A square lattice of spacing a: 4 neighbours at a, 4 at a sqrt(2), so the 8th nearest
+  // other point of an interior point is at a sqrt(2); border points see farther ones.
+  std::vector<Vec3d> points;
+  const double a = 0.1;
+  for (int j = 0; j < 40; ++j)
+    for (int i = 0; i < 40; ++i) points.push_back({i * a, j * a, 0.0});
+  const PointIndex index(points);
+  EXPECT_NEAR(sample_gap(index, 8, 0.5, 1600), a * std::sqrt(2.0), 1e-12);
+  EXPECT_GT(sample_gap(index, 8, 1.0, 1600), a * std::sqrt(2.0) + 1e-6);  // a corner point
+  EXPECT_NEAR(sample_gap(index, 1, 0.5, 1600), a, 1e-12);
+}
+
+TEST(Reconstruction, SparsePointsOnTwoLevelsKeepTheInside) {
+  // 1500 points on a unit sphere at resolution 128 with two levels: the samples are ~3
+  // coarse voxels apart, wider than a fixed start shell of 2 coarse voxels closes, so its
+  // flood fill leaked inside and the flow collapsed the shell onto the points (Chamfer of
+  // dozens of voxels). The offset follows the sampling's gaps instead.
+  const auto sphere = make_sphere({0, 0, 0}, 1.0);
+  ReconstructionOptions o;
+  o.resolution = 128;
+  o.levels = 2;
+  const ReconstructionResult r = reconstruct_surface(samples(*sphere, 1500, 0.0, 3), o);
+  EXPECT_GT(r.stages.front().shell_offset, o.shell_offset);
+  EXPECT_TRUE(r.measures.watertight);
+  EXPECT_EQ(r.measures.components, 1u);
+  EXPECT_EQ(r.measures.genus, 0.0);
+  EXPECT_NEAR(r.measures.volume, 4.0 / 3.0 * std::numbers::pi, 0.05 * 4.0 / 3.0 * std::numbers::pi);
+  EXPECT_LT(accuracy(r, *sphere).chamfer, 0.5);
+}
+
 TEST(Reconstruction, KnotHasGenusOneAndSubVoxelChamfer) {
   const auto knot = make_builtin_shape("knot");
   ReconstructionOptions o;
