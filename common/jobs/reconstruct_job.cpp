@@ -7,7 +7,9 @@
 //           count = 20000  noise = 0 (x the bbox diagonal)  seed = 1 }
 //   reconstruct { levels = 3  neighbors = 8  curvature_weight = 0.3  max_steps = 120
 //                 snap_passes = 1  clean_final_passes = 2  tolerance = 0.01  shell_offset = 2
-//                 accuracy_samples = 100000 }
+//                 guard_flow = yes  guard_snaps = yes  free_distance = 1  accuracy_samples = 100000 }
+//   (guard_*: keep the start shell's topology in the coarse flow / the snaps; free_distance:
+//   coarse voxels from the nearest sample beyond which the flow may change it)
 // The raster's resolution / voxel_size / band are the final level's.
 #include <functional>
 #include <memory>
