@@ -1,6 +1,7 @@
 #include "jobs/job_context.hpp"
 
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -72,6 +73,15 @@ const config::Set& JobContext::section(std::string_view key, const std::vector<s
   return e->set;
 }
 
+namespace {
+// A bound as a reader writes it: 1000, 0.5, 1e-09 (not std::to_string's 1000.000000).
+std::string shortest(double v) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.10g", v);
+  return text;
+}
+}  // namespace
+
 double JobContext::number(const config::Set& set, std::string_view key, double fallback, double lo, double hi) const {
   if (!has(set, key)) return fallback;
   const config::Entry& e = entry(set, key);
@@ -81,8 +91,7 @@ double JobContext::number(const config::Set& set, std::string_view key, double f
   const double v = e.value.number;
   if (!std::isfinite(v) || v < lo || v > hi)
     throw Error(ErrorCode::InvalidArgument, place(set, key),
-                "'" + std::string(key) + "' = " + e.value.text + " is outside [" + std::to_string(lo) + ", " +
-                    std::to_string(hi) + "]");
+                "'" + std::string(key) + "' = " + e.value.text + " is outside [" + shortest(lo) + ", " + shortest(hi) + "]");
   return v;
 }
 

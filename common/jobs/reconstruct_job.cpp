@@ -34,6 +34,28 @@ void run_reconstruct_job(JobContext& ctx) {
     throw Error(ErrorCode::InvalidArgument, ctx.options().name,
                 "the input set needs exactly one of points = FILE, sample = SHAPE, sample_mesh = FILE");
 
+  // Every option is read (and checked) before the points are read or sampled and the work
+  // starts, so a bad value fails at once.
+  apps::ReconstructionOptions o;
+  const JobContext::Raster r = ctx.raster(256, 3);
+  o.resolution = r.voxel_size > 0 ? 0 : r.resolution;
+  o.voxel_size = r.voxel_size;
+  o.half_width = r.band;
+  o.levels = ctx.integer(s, "levels", o.levels, 1, 6);
+  o.neighbors = ctx.integer(s, "neighbors", o.neighbors, 1, 256);
+  o.curvature_weight = ctx.number(s, "curvature_weight", o.curvature_weight, 0.0, 100.0);
+  o.max_steps = ctx.integer(s, "max_steps", o.max_steps, 1, 100000);
+  o.snap_passes = ctx.integer(s, "snap_passes", o.snap_passes, 0, 16);
+  o.clean_final_passes = ctx.integer(s, "clean_final_passes", o.clean_final_passes, 0, 16);
+  o.guard_flow = ctx.flag(s, "guard_flow", o.guard_flow);
+  o.guard_snaps = ctx.flag(s, "guard_snaps", o.guard_snaps);
+  o.free_distance = ctx.number(s, "free_distance", o.free_distance, 0.0, 100.0);
+  o.tolerance = ctx.number(s, "tolerance", o.tolerance, 1e-9, 10.0);
+  o.shell_offset = ctx.number(s, "shell_offset", o.shell_offset, 1.0, 16.0);
+  o.progress = ctx.options().progress;
+  o.log = [&ctx](const std::string& line) { ctx.log(line); };
+  const std::size_t accuracy_samples = static_cast<std::size_t>(ctx.integer(s, "accuracy_samples", 100000, 1000, 1 << 24));
+
   // The points, and the true surface when they were sampled from one.
   std::vector<Vec3d> points;
   std::unique_ptr<AnalyticShape> shape;
@@ -64,24 +86,6 @@ void run_reconstruct_job(JobContext& ctx) {
     ctx.log("input: " + std::to_string(points.size()) + " points sampled on " + path);
   }
 
-  apps::ReconstructionOptions o;
-  const JobContext::Raster r = ctx.raster(256, 3);
-  o.resolution = r.voxel_size > 0 ? 0 : r.resolution;
-  o.voxel_size = r.voxel_size;
-  o.half_width = r.band;
-  o.levels = ctx.integer(s, "levels", o.levels, 1, 6);
-  o.neighbors = ctx.integer(s, "neighbors", o.neighbors, 1, 256);
-  o.curvature_weight = ctx.number(s, "curvature_weight", o.curvature_weight, 0.0, 100.0);
-  o.max_steps = ctx.integer(s, "max_steps", o.max_steps, 1, 100000);
-  o.snap_passes = ctx.integer(s, "snap_passes", o.snap_passes, 0, 16);
-  o.clean_final_passes = ctx.integer(s, "clean_final_passes", o.clean_final_passes, 0, 16);
-  o.guard_flow = ctx.flag(s, "guard_flow", o.guard_flow);
-  o.guard_snaps = ctx.flag(s, "guard_snaps", o.guard_snaps);
-  o.free_distance = ctx.number(s, "free_distance", o.free_distance, 0.0, 100.0);
-  o.tolerance = ctx.number(s, "tolerance", o.tolerance, 1e-9, 10.0);
-  o.shell_offset = ctx.number(s, "shell_offset", o.shell_offset, 1.0, 16.0);
-  o.progress = ctx.options().progress;
-  o.log = [&ctx](const std::string& line) { ctx.log(line); };
   const apps::ReconstructionResult result = apps::reconstruct_surface(points, o);
   ctx.stats()["reconstruct"] = {{"points", points.size()},     {"voxel_size", result.voxel_size},
                                 {"steps", result.steps},       {"seconds", result.seconds},
@@ -91,7 +95,7 @@ void run_reconstruct_job(JobContext& ctx) {
   if (truth_distance) {
     // Accuracy against the true surface, from dense samples of both.
     apps::SurfaceSampleOptions dense;
-    dense.count = static_cast<std::size_t>(ctx.integer(s, "accuracy_samples", 100000, 1000, 1 << 24));
+    dense.count = accuracy_samples;
     dense.seed = 12345;
     const std::vector<Vec3d> ours = apps::sample_mesh_surface(result.mesh, dense);
     const std::vector<Vec3d> truth = shape ? apps::sample_shape_surface(*shape, dense) : apps::sample_mesh_surface(truth_mesh, dense);
