@@ -74,7 +74,7 @@ double dice(const std::vector<std::uint8_t>& a, const std::vector<std::uint8_t>&
   if (a.size() != b.size()) throw Error(ErrorCode::InvalidArgument, "dice", "masks of different sizes");
   std::uint64_t both = 0, na = 0, nb = 0;
   for (std::size_t v = 0; v < a.size(); ++v) {
-    both += (a[v] != 0) & (b[v] != 0);
+    both += (a[v] != 0 && b[v] != 0) ? 1 : 0;
     na += a[v] != 0;
     nb += b[v] != 0;
   }

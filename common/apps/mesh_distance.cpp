@@ -38,9 +38,11 @@ double MeshDistance::distance(const Vec3d& p) const {
   return std::sqrt(best);
 }
 
-OneSidedDistance distances_to(const std::vector<Vec3d>& samples, const std::function<double(const Vec3d&)>& distance) {
+OneSidedDistance distances_to(const std::vector<Vec3d>& samples, const std::function<double(const Vec3d&)>& distance,
+                              const ProgressHook& progress) {
   std::vector<double> d(samples.size());
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, samples.size(), 256), [&](const tbb::blocked_range<std::size_t>& r) {
+    progress.check("surface distance");
     for (std::size_t i = r.begin(); i != r.end(); ++i) d[i] = std::abs(distance(samples[i]));
   });
   OneSidedDistance o;
@@ -58,10 +60,11 @@ OneSidedDistance distances_to(const std::vector<Vec3d>& samples, const std::func
 }
 
 SurfaceDistance surface_distance(const std::vector<Vec3d>& a_samples, const std::function<double(const Vec3d&)>& b_distance,
-                                 const std::vector<Vec3d>& b_samples, const std::function<double(const Vec3d&)>& a_distance) {
+                                 const std::vector<Vec3d>& b_samples, const std::function<double(const Vec3d&)>& a_distance,
+                                 const ProgressHook& progress) {
   SurfaceDistance s;
-  s.a_to_b = distances_to(a_samples, b_distance);
-  s.b_to_a = distances_to(b_samples, a_distance);
+  s.a_to_b = distances_to(a_samples, b_distance, progress);
+  s.b_to_a = distances_to(b_samples, a_distance, progress);
   s.chamfer = 0.5 * (s.a_to_b.mean + s.b_to_a.mean);
   s.hausdorff = std::max(s.a_to_b.max, s.b_to_a.max);
   return s;

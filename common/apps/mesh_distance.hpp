@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "apps/point_distance.hpp"
+#include "core/progress.hpp"
 #include "io/triangle_mesh.hpp"
 
 namespace levelset::apps {
@@ -38,7 +39,9 @@ struct OneSidedDistance {
 };
 
 // Distances of the samples to a surface given by its distance function (thread-safe).
-OneSidedDistance distances_to(const std::vector<Vec3d>& samples, const std::function<double(const Vec3d&)>& distance);
+// progress: checked per chunk of samples (Error{Cancelled}).
+OneSidedDistance distances_to(const std::vector<Vec3d>& samples, const std::function<double(const Vec3d&)>& distance,
+                              const ProgressHook& progress = {});
 
 struct SurfaceDistance {
   OneSidedDistance a_to_b, b_to_a;
@@ -47,6 +50,7 @@ struct SurfaceDistance {
 };
 
 SurfaceDistance surface_distance(const std::vector<Vec3d>& a_samples, const std::function<double(const Vec3d&)>& b_distance,
-                                 const std::vector<Vec3d>& b_samples, const std::function<double(const Vec3d&)>& a_distance);
+                                 const std::vector<Vec3d>& b_samples, const std::function<double(const Vec3d&)>& a_distance,
+                                 const ProgressHook& progress = {});
 
 }  // namespace levelset::apps

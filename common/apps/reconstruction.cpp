@@ -46,6 +46,20 @@ void for_each_active_neighbour27(const NarrowBand& band, BandAccessor& acc, cons
       }
 }
 
+// Calls f(acc, b, c, value, slot) for every active voxel c of `band` (brick b, value index
+// slot), TBB over chunks of `grain` bricks, with one BandAccessor of `accessed` per chunk.
+template <typename F>
+void for_each_active_parallel(const NarrowBand& band, const NarrowBand& accessed, std::uint32_t grain, F&& f) {
+  tbb::parallel_for(tbb::blocked_range<std::uint32_t>(0, std::uint32_t(band.brick_count()), grain),
+                    [&](const tbb::blocked_range<std::uint32_t>& r) {
+                      BandAccessor acc(accessed);
+                      for (std::uint32_t b = r.begin(); b != r.end(); ++b) {
+                        std::size_t slot = band.bricks()[b].value_offset;
+                        band.for_each_active_in_brick(b, [&](const Coord& c, float v) { f(acc, b, c, v, slot++); });
+                      }
+                    });
+}
+
 using Clock = std::chrono::steady_clock;
 
 // The coarsest level's attraction: beta = -clamp(gain * offset / h): a front within
@@ -392,17 +406,10 @@ double central_mean_curvature(BandAccessor& acc, const Coord& c, double u, doubl
 std::vector<float> mean_curvature_field(const NarrowBand& band) {
   const double h = band.voxel_size();
   std::vector<float> H(band.active_voxel_count());
-  tbb::parallel_for(tbb::blocked_range<std::uint32_t>(0, std::uint32_t(band.brick_count()), 8),
-                    [&](const tbb::blocked_range<std::uint32_t>& r) {
-                      BandAccessor acc(band);
-                      for (std::uint32_t b = r.begin(); b != r.end(); ++b) {
-                        std::size_t slot = band.bricks()[b].value_offset;
-                        band.for_each_active_in_brick(b, [&](const Coord& c, float u) {
-                          Vec3d g;
-                          H[slot++] = float(std::clamp(central_mean_curvature(acc, c, double(u), h, g), -1.0 / h, 1.0 / h));
-                        });
-                      }
-                    });
+  for_each_active_parallel(band, band, 8, [&](BandAccessor& acc, std::uint32_t, const Coord& c, float u, std::size_t slot) {
+    Vec3d g;
+    H[slot] = float(std::clamp(central_mean_curvature(acc, c, double(u), h, g), -1.0 / h, 1.0 / h));
+  });
   return H;
 }
 
@@ -510,17 +517,9 @@ std::uint64_t keep_topology(const NarrowBand& before, const NarrowBand& after, s
   };
   // Sign changes, found per brick (TBB) and kept in brick order.
   std::vector<std::vector<Candidate>> per_brick(after.brick_count());
-  tbb::parallel_for(tbb::blocked_range<std::uint32_t>(0, std::uint32_t(after.brick_count()), 16),
-                    [&](const tbb::blocked_range<std::uint32_t>& r) {
-                      BandAccessor acc(before);
-                      for (std::uint32_t b = r.begin(); b != r.end(); ++b) {
-                        std::size_t slot = after.bricks()[b].value_offset;
-                        after.for_each_active_in_brick(b, [&](const Coord& c, float) {
-                          const std::size_t i = slot++;
-                          if ((values[i] < 0.0f) != acc.is_inside(c)) per_brick[b].push_back({c, i});
-                        });
-                      }
-                    });
+  for_each_active_parallel(after, before, 16, [&](BandAccessor& acc, std::uint32_t b, const Coord& c, float, std::size_t i) {
+    if ((values[i] < 0.0f) != acc.is_inside(c)) per_brick[b].push_back({c, i});
+  });
   std::vector<Candidate> pending;
   for (const auto& list : per_brick) pending.insert(pending.end(), list.begin(), list.end());
   BandAccessor old_acc(before);
@@ -813,59 +812,43 @@ SnapPass snap_to_fits(NarrowBand& band, const PointIndex& index, const SnapSetti
                                                 : int(std::min<long>(kMaxSmoothing, std::lround(kSmoothingGain * sigma * sigma)));
   for (int smooth = 0; smooth < smoothing; ++smooth) {
     std::vector<float> smoothed(offset.size(), unset);
-    tbb::parallel_for(tbb::blocked_range<std::uint32_t>(0, std::uint32_t(band.brick_count()), 8),
-                      [&](const tbb::blocked_range<std::uint32_t>& r) {
-                        BandAccessor acc(band);
-                        for (std::uint32_t b = r.begin(); b != r.end(); ++b) {
-                          std::size_t slot = band.bricks()[b].value_offset;
-                          band.for_each_active_in_brick(b, [&](const Coord& c, float) {
-                            const std::size_t i = slot++;
-                            if (!moves[i]) return;
-                            double sum = 0.0;
-                            int n = 0;
-                            for_each_active_neighbour27(band, acc, c, [&](int, std::size_t j) {
-                              if (std::isnan(offset[j])) return;
-                              sum += double(offset[j]);
-                              ++n;
-                            });
-                            if (n > 0) smoothed[i] = float(sum / n);
-                          });
-                        }
-                      });
+    for_each_active_parallel(band, band, 8, [&](BandAccessor& acc, std::uint32_t, const Coord& c, float, std::size_t i) {
+      if (!moves[i]) return;
+      double sum = 0.0;
+      int n = 0;
+      for_each_active_neighbour27(band, acc, c, [&](int, std::size_t j) {
+        if (std::isnan(offset[j])) return;
+        sum += double(offset[j]);
+        ++n;
+      });
+      if (n > 0) smoothed[i] = float(sum / n);
+    });
     offset.swap(smoothed);
   }
   std::vector<float> next(band.values().begin(), band.values().end());
   std::vector<double> change(band.brick_count(), 0.0);
   std::vector<std::uint32_t> count(band.brick_count(), 0);
-  tbb::parallel_for(tbb::blocked_range<std::uint32_t>(0, std::uint32_t(band.brick_count()), 8),
-                    [&](const tbb::blocked_range<std::uint32_t>& r) {
-                      BandAccessor acc(band);
-                      for (std::uint32_t b = r.begin(); b != r.end(); ++b) {
-                        std::size_t slot = band.bricks()[b].value_offset;
-                        band.for_each_active_in_brick(b, [&](const Coord& c, float value) {
-                          const std::size_t i = slot++;
-                          if (!moves[i]) return;
-                          const double u = double(value);
-                          const bool inside = u < 0.0;
-                          bool at_front = false;
-                          double sum = 0.0;
-                          int n = 0;
-                          for_each_active_neighbour27(band, acc, c, [&](int taxicab, std::size_t j) {
-                            if (taxicab == 1 && (band.values()[j] < 0.0f) != inside) at_front = true;
-                            if (std::isnan(offset[j])) return;
-                            if (clean && taxicab > 1) return;
-                            sum += double(offset[j]);
-                            ++n;
-                          });
-                          if (n == 0) return;
-                          double target = u + sum / n;
-                          if (!at_front && (target < 0.0) != inside) target = inside ? -1e-3 * h : 1e-3 * h;
-                          next[i] = float(target);
-                          change[b] += std::abs(target - u) / h;
-                          ++count[b];
-                        });
-                      }
-                    });
+  for_each_active_parallel(band, band, 8, [&](BandAccessor& acc, std::uint32_t b, const Coord& c, float value, std::size_t i) {
+    if (!moves[i]) return;
+    const double u = double(value);
+    const bool inside = u < 0.0;
+    bool at_front = false;
+    double sum = 0.0;
+    int n = 0;
+    for_each_active_neighbour27(band, acc, c, [&](int taxicab, std::size_t j) {
+      if (taxicab == 1 && (band.values()[j] < 0.0f) != inside) at_front = true;
+      if (std::isnan(offset[j])) return;
+      if (clean && taxicab > 1) return;
+      sum += double(offset[j]);
+      ++n;
+    });
+    if (n == 0) return;
+    double target = u + sum / n;
+    if (!at_front && (target < 0.0) != inside) target = inside ? -1e-3 * h : 1e-3 * h;
+    next[i] = float(target);
+    change[b] += std::abs(target - u) / h;
+    ++count[b];
+  });
   const std::uint64_t refused = settings.guard ? keep_topology(band, band, next, 1e-3 * h) : 0;
   if (settings.guard) keep_face_decisions(band, band, next);
   band.swap_values(next);

@@ -52,7 +52,9 @@ std::vector<Vec3d> sample_mesh_surface(const TriangleMesh& mesh, const SurfaceSa
     throw Error(ErrorCode::InvalidArgument, "sample points", "the mesh has no area");
   Random rng(o.seed);
   std::vector<Vec3d> points(o.count);
-  for (Vec3d& p : points) {
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    if ((i & 0xffff) == 0) o.progress.check("sample points");
+    Vec3d& p = points[i];
     const double pick = rng.uniform() * total;
     const std::size_t t = std::min(std::size_t(std::upper_bound(cumulative.begin(), cumulative.end(), pick) - cumulative.begin()),
                                    cumulative.size() - 1);
@@ -76,14 +78,19 @@ std::vector<Vec3d> sample_shape_surface(const AnalyticShape& shape, const Surfac
   const BBox bounds = shape.bounds();
   SdfBuildOptions build;
   build.frame = frame_for_resolution(bounds, o.resolution, 2.0);
+  build.progress = o.progress;
   const NarrowBand band = build_from_sdf([&](const Vec3d& p) { return shape.distance(p); }, bounds, build).band;
-  const TriangleMesh mesh = marching_cubes(band).mesh;
+  MarchingCubesOptions mc;
+  mc.progress = o.progress;
+  const TriangleMesh mesh = marching_cubes(band, mc).mesh;
   SurfaceSampleOptions clean = o;
   clean.noise = 0.0;
   std::vector<Vec3d> points = sample_mesh_surface(mesh, clean);
   const Vec3d ext = bounds.extent();
   const double eps = 1e-6 * std::max({ext.x, ext.y, ext.z});
-  for (Vec3d& p : points)
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    if ((i & 0xffff) == 0) o.progress.check("sample points");
+    Vec3d& p = points[i];
     for (int it = 0; it < 2; ++it) {
       const double d = shape.distance(p);
       Vec3d g{};
@@ -95,6 +102,7 @@ std::vector<Vec3d> sample_shape_surface(const AnalyticShape& shape, const Surfac
       const double gl = length(g);
       if (gl > 0.0) p -= g * (d / (gl * gl));
     }
+  }
   if (o.noise > 0.0) {
     Random rng(o.seed ^ 0x9e3779b97f4a7c15ull);
     for (Vec3d& p : points) p += Vec3d{rng.gaussian(), rng.gaussian(), rng.gaussian()} * o.noise;

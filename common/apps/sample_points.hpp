@@ -9,7 +9,7 @@
 //   The density is uniform by area up to the mesh's O(h^2) area distortion.
 // Random numbers: std::mt19937_64(seed) mapped by our own code (53-bit uniforms, Box-Muller),
 //   so the samples are identical on every platform and for any thread count (serial).
-// Errors: Error{InvalidArgument} for count 0 or above 2^28, a negative or non-finite noise,
+// Errors: Error{Cancelled} through options.progress; Error{InvalidArgument} for count 0 or above 2^28, a negative or non-finite noise,
 //   a mesh without area or with an index out of range.
 #pragma once
 
@@ -17,6 +17,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "core/progress.hpp"
 #include "core/vec3.hpp"
 #include "geometry/analytic_shapes.hpp"
 #include "io/triangle_mesh.hpp"
@@ -28,6 +29,7 @@ struct SurfaceSampleOptions {
   double noise = 0.0;           // standard deviation of the Gaussian noise, world units
   std::uint64_t seed = 1;
   int resolution = 128;         // sample_shape_surface: the mesh it samples first
+  ProgressHook progress;        // checked per 2^16 points and inside the shape's meshing
 };
 
 std::vector<Vec3d> sample_mesh_surface(const TriangleMesh& mesh, const SurfaceSampleOptions& options);

@@ -147,14 +147,17 @@ void gather_box(const NarrowBand& band, const Neighborhood& around, int lo, int 
             const std::uint32_t act = std::uint32_t(act_word >> bit0) & 0xffu;
             const std::uint32_t ins = std::uint32_t(ins_word >> bit0) & 0xffu;
             const std::size_t row = index(lo, y + dy * kBrickDim, z + dz * kBrickDim);
-            float* o = &out[row + std::size_t(dx * kBrickDim - lo)];
+            // Box index of local x: row + (x + dx * kBrickDim - lo), the last term >= 0. Alone,
+            // dx * kBrickDim - lo is negative for dx = -1, so no pointer is formed from it
+            // (UBSan: pointer overflow); the unsigned sum wraps back exactly.
+            const std::size_t base = row - std::size_t(lo - dx * kBrickDim);
             // Branch-free per voxel: the value's address is selected, not branched on (the
             // active pattern of a row is unpredictable).
             const float* row_values = vals + rank_z + std::popcount(act_word & ((std::uint64_t{1} << bit0) - 1));
             const std::uint32_t before = kActiveBefore[act];
             for (int x = nlo[0]; x < nhi[0]; ++x) {
               const float* src = ((act >> x) & 1u) ? row_values + ((before >> (4 * x)) & 15u) : &sign_value[(ins >> x) & 1u];
-              o[x] = *src;
+              out[base + std::size_t(x)] = *src;
             }
             if (rows)
               active_rows[std::size_t(y + dy * kBrickDim - lo) + dim * std::size_t(z + dz * kBrickDim - lo)] |=

@@ -63,7 +63,8 @@ void run_reconstruct_job(JobContext& ctx) {
   std::function<double(const Vec3d&)> truth_distance;
   std::unique_ptr<apps::MeshDistance> truth_mesh_distance;
   apps::SurfaceSampleOptions sampling;
-  sampling.count = static_cast<std::size_t>(ctx.integer(in, "count", 20000, 4, 1 << 26));
+  sampling.count = static_cast<std::size_t>(ctx.integer(in, "count", 20000, 4, 1 << 24));
+  sampling.progress = ctx.options().progress;
   sampling.seed = static_cast<std::uint64_t>(ctx.integer(in, "seed", 1, 0, 1 << 30));
   const double noise = ctx.number(in, "noise", 0.0, 0.0, 0.1);
   if (ctx.has(in, "points")) {
@@ -97,11 +98,13 @@ void run_reconstruct_job(JobContext& ctx) {
     apps::SurfaceSampleOptions dense;
     dense.count = accuracy_samples;
     dense.seed = 12345;
+    dense.progress = ctx.options().progress;
     const std::vector<Vec3d> ours = apps::sample_mesh_surface(result.mesh, dense);
     const std::vector<Vec3d> truth = shape ? apps::sample_shape_surface(*shape, dense) : apps::sample_mesh_surface(truth_mesh, dense);
     const apps::MeshDistance ours_distance(result.mesh);
     const apps::SurfaceDistance d =
-        apps::surface_distance(ours, truth_distance, truth, [&](const Vec3d& p) { return ours_distance.distance(p); });
+        apps::surface_distance(ours, truth_distance, truth, [&](const Vec3d& p) { return ours_distance.distance(p); },
+                               ctx.options().progress);
     const BBox box = shape ? shape->bounds() : truth_mesh.bounds();
     const double diagonal = length(box.extent());
     ctx.stats()["accuracy"] = {{"chamfer", d.chamfer},
