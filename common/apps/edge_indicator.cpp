@@ -51,8 +51,9 @@ Vec3d difference(const ImageVolume& im, std::int64_t i, std::int64_t j, std::int
   return d;
 }
 
-void for_each_slice(const ImageVolume& im, const std::function<void(std::int64_t)>& f) {
+void for_each_slice(const ImageVolume& im, const ProgressHook& progress, const std::function<void(std::int64_t)>& f) {
   tbb::parallel_for(tbb::blocked_range<std::int64_t>(0, im.nz), [&](const tbb::blocked_range<std::int64_t>& r) {
+    progress.check("edges");
     for (std::int64_t k = r.begin(); k != r.end(); ++k) f(k);
   });
 }
@@ -76,7 +77,7 @@ EdgeIndicator edge_indicator(const ImageVolume& image, const EdgeIndicatorOption
   normal = {};
   const double voxel = std::min({image.spacing.x, image.spacing.y, image.spacing.z});
   e.g = smooth;
-  for_each_slice(image, [&](std::int64_t k) {
+  for_each_slice(image, o.progress, [&](std::int64_t k) {
     for (std::int64_t j = 0; j < image.ny; ++j)
       for (std::int64_t i = 0; i < image.nx; ++i) {
         const double m = length(difference(smooth, i, j, k, [&](std::size_t x) { return double(smooth.samples[x]); })) *
@@ -86,7 +87,7 @@ EdgeIndicator edge_indicator(const ImageVolume& image, const EdgeIndicatorOption
   });
   o.progress.step(1.0, "edges");
   e.gradient.resize(image.voxel_count());
-  for_each_slice(image, [&](std::int64_t k) {
+  for_each_slice(image, o.progress, [&](std::int64_t k) {
     for (std::int64_t j = 0; j < image.ny; ++j)
       for (std::int64_t i = 0; i < image.nx; ++i) {
         const Vec3d d = difference(e.g, i, j, k, [&](std::size_t x) { return double(e.g.samples[x]); });

@@ -14,7 +14,8 @@ namespace levelset::apps {
 namespace {
 
 // One pass along `axis` from src into dst.
-void convolve_axis(const ImageVolume& src, ImageVolume& dst, int axis, const std::vector<double>& kernel) {
+void convolve_axis(const ImageVolume& src, ImageVolume& dst, int axis, const std::vector<double>& kernel,
+                   const ProgressHook& progress) {
   const std::int64_t n[3] = {src.nx, src.ny, src.nz};
   const std::int64_t stride[3] = {1, src.nx, src.nx * src.ny};
   const int a = axis, b = (axis + 1) % 3, c = (axis + 2) % 3;
@@ -22,6 +23,7 @@ void convolve_axis(const ImageVolume& src, ImageVolume& dst, int axis, const std
   const std::int64_t len = n[a];
   const int r = int(kernel.size() / 2);
   tbb::parallel_for(tbb::blocked_range<std::int64_t>(0, lines, 64), [&](const tbb::blocked_range<std::int64_t>& range) {
+    progress.check("smooth");
     std::vector<float> line(std::size_t(len + 2 * r));
     for (std::int64_t l = range.begin(); l != range.end(); ++l) {
       const std::int64_t start = (l % n[b]) * stride[b] + (l / n[b]) * stride[c];
@@ -51,11 +53,11 @@ ImageVolume gaussian_smooth(const ImageVolume& image, double sigma, const Progre
   for (int k = -r; k <= r; ++k) total += kernel[std::size_t(k + r)] = std::exp(-0.5 * k * k / (sigma * sigma));
   for (double& k : kernel) k /= total;
   ImageVolume tmp = image;
-  convolve_axis(image, tmp, 0, kernel);
+  convolve_axis(image, tmp, 0, kernel, progress);
   progress.step(1.0 / 3, "smooth");
-  convolve_axis(tmp, out, 1, kernel);
+  convolve_axis(tmp, out, 1, kernel, progress);
   progress.step(2.0 / 3, "smooth");
-  convolve_axis(out, tmp, 2, kernel);
+  convolve_axis(out, tmp, 2, kernel, progress);
   progress.step(1.0, "smooth");
   return tmp;
 }

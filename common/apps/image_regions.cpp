@@ -27,10 +27,11 @@ ImageVolume downsample_image(const ImageVolume& im, int f) {
   return out;
 }
 
-std::vector<std::size_t> seed_voxels_above(const ImageVolume& im, float t, int stride, int r) {
+std::vector<std::size_t> seed_voxels_above(const ImageVolume& im, float t, int stride, int r, const ProgressHook& progress) {
   std::vector<std::size_t> seeds;
   const int stride_z = std::max(1, stride / 2);
-  for (std::int64_t k = r; k + r < im.nz; ++k)
+  for (std::int64_t k = r; k + r < im.nz; ++k) {
+    progress.check("seeds");
     for (std::int64_t j = r; j + r < im.ny; ++j)
       for (std::int64_t i = r; i + r < im.nx; ++i) {
         if (i % stride != 0 || j % stride != 0 || k % stride_z != 0) continue;
@@ -40,10 +41,12 @@ std::vector<std::size_t> seed_voxels_above(const ImageVolume& im, float t, int s
             for (int dx = -r; dx <= r && all; ++dx) all = im.at(i + dx, j + dy, k + dz) > t;
         if (all) seeds.push_back(im.index(i, j, k));
       }
+  }
   return seeds;
 }
 
-std::vector<std::uint8_t> threshold_component(const ImageVolume& im, float t, const std::vector<std::size_t>& seeds) {
+std::vector<std::uint8_t> threshold_component(const ImageVolume& im, float t, const std::vector<std::size_t>& seeds,
+                                              const ProgressHook& progress) {
   std::vector<std::uint8_t> in(im.voxel_count(), 0);
   std::vector<std::size_t> stack;
   for (const std::size_t s : seeds) {
@@ -53,7 +56,8 @@ std::vector<std::uint8_t> threshold_component(const ImageVolume& im, float t, co
   }
   const std::int64_t step[3] = {1, im.nx, im.nx * im.ny};
   const std::int64_t n[3] = {im.nx, im.ny, im.nz};
-  while (!stack.empty()) {
+  for (std::uint64_t popped = 0; !stack.empty(); ++popped) {
+    if ((popped & 0xfffff) == 0) progress.check("threshold component");
     const std::size_t v = stack.back();
     stack.pop_back();
     const std::int64_t c[3] = {std::int64_t(v) % im.nx, (std::int64_t(v) / im.nx) % im.ny, std::int64_t(v) / (im.nx * im.ny)};

@@ -8,20 +8,24 @@
 //   threshold_component: the 6-connected components of {I > t} that contain the seed voxels
 //     (a seed at or below t starts none), as a 0/1 mask.
 //   dice: 2 |A and B| / (|A| + |B|) of two 0/1 masks of equal size (1 when both are empty).
-// Cost: O(voxels). Threading: serial (downsample_image: TBB over slices).
+// Cost: O(voxels). Threading: serial (downsample_image: TBB over slices). progress: checked
+//   per slice / per 2^20 voxels (Error{Cancelled}).
 #pragma once
 
 #include <cstddef>
 #include <cstdint>
 #include <vector>
 
+#include "core/progress.hpp"
 #include "io/image_volume.hpp"
 
 namespace levelset::apps {
 
 ImageVolume downsample_image(const ImageVolume& image, int factor);
-std::vector<std::size_t> seed_voxels_above(const ImageVolume& image, float t, int stride, int box_radius);
-std::vector<std::uint8_t> threshold_component(const ImageVolume& image, float t, const std::vector<std::size_t>& seeds);
+std::vector<std::size_t> seed_voxels_above(const ImageVolume& image, float t, int stride, int box_radius,
+                                           const ProgressHook& progress = {});
+std::vector<std::uint8_t> threshold_component(const ImageVolume& image, float t, const std::vector<std::size_t>& seeds,
+                                              const ProgressHook& progress = {});
 double dice(const std::vector<std::uint8_t>& a, const std::vector<std::uint8_t>& b);
 
 }  // namespace levelset::apps

@@ -39,7 +39,7 @@ void run_segment_job(JobContext& ctx) {
     }
   } else {
     const float t = static_cast<float>(ctx.number(s, "seed_above", 0.0, -1e30, 1e30));
-    seed_voxels = apps::seed_voxels_above(image, t, ctx.integer(s, "seed_stride", 6, 1, 1000), 3);
+    seed_voxels = apps::seed_voxels_above(image, t, ctx.integer(s, "seed_stride", 6, 1, 1000), 3, ctx.options().progress);
     if (seed_voxels.empty())
       throw Error(ErrorCode::InvalidArgument, ctx.place(s, "seed_above"), "no voxel's 7^3 box lies above the threshold");
     for (const std::size_t v : seed_voxels) {
@@ -78,7 +78,7 @@ void run_segment_job(JobContext& ctx) {
                             {"seconds", {{"edges", r.seconds_edges}, {"evolve", r.seconds_evolve}, {"total", r.seconds_total}}}};
   if (o.label_mask) {
     const float t = static_cast<float>(ctx.number(s, "reference_threshold", 0.0, -1e30, 1e30));
-    const std::vector<std::uint8_t> reference = apps::threshold_component(image, t, seed_voxels);
+    const std::vector<std::uint8_t> reference = apps::threshold_component(image, t, seed_voxels, ctx.options().progress);
     const double d = apps::dice(reference, r.label_mask);
     ctx.stats()["segment"]["dice_vs_threshold"] = d;
     ctx.log("Dice against the threshold component: " + std::to_string(d));
