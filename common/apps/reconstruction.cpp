@@ -1,7 +1,6 @@
 #include "apps/reconstruction.hpp"
 
 #include <algorithm>
-#include <array>
 #include <chrono>
 #include <cmath>
 #include <atomic>
@@ -10,7 +9,6 @@
 #include <limits>
 #include <optional>
 #include <string>
-#include <unordered_map>
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
@@ -22,7 +20,9 @@
 #include "grid/band_accessor.hpp"
 #include "grid/band_builder.hpp"
 #include "grid/build_from_sdf.hpp"
+#include "grid/for_each_active_parallel.hpp"
 #include "grid/sign_components.hpp"
+#include "grid/topology_guard.hpp"
 #include "surface/marching_cubes.hpp"
 
 namespace levelset::apps {
@@ -44,20 +44,6 @@ void for_each_active_neighbour27(const NarrowBand& band, BandAccessor& acc, cons
         if (!br.active.test(qn)) continue;
         f(std::abs(dx) + std::abs(dy) + std::abs(dz), br.value_offset + br.slot(qn));
       }
-}
-
-// Calls f(acc, b, c, value, slot) for every active voxel c of `band` (brick b, value index
-// slot), TBB over chunks of `grain` bricks, with one BandAccessor of `accessed` per chunk.
-template <typename F>
-void for_each_active_parallel(const NarrowBand& band, const NarrowBand& accessed, std::uint32_t grain, F&& f) {
-  tbb::parallel_for(tbb::blocked_range<std::uint32_t>(0, std::uint32_t(band.brick_count()), grain),
-                    [&](const tbb::blocked_range<std::uint32_t>& r) {
-                      BandAccessor acc(accessed);
-                      for (std::uint32_t b = r.begin(); b != r.end(); ++b) {
-                        std::size_t slot = band.bricks()[b].value_offset;
-                        band.for_each_active_in_brick(b, [&](const Coord& c, float v) { f(acc, b, c, v, slot++); });
-                      }
-                    });
 }
 
 using Clock = std::chrono::steady_clock;
@@ -413,243 +399,6 @@ std::vector<float> mean_curvature_field(const NarrowBand& band) {
   return H;
 }
 
-// Topology control. A voxel's sign may change only where it is a simple point: flipping it
-// changes neither the number of components of the inside and outside voxel sets nor their
-// handles (3x3x3 test after Bertrand: one component of the inside and one of the outside in
-// the neighbourhood, each touching the voxel). The marching cubes resolve ambiguous faces by
-// the asymptotic decider, which follows neither fixed adjacency pair, so a flip is taken only
-// when it is simple for both (26, 6) and (6, 26). Why: a part thinner than the voxel (the
-// bunny's ears at the coarse levels, a thin sheet under noisy fits) otherwise breaks into
-// pieces or grows handles when the front crosses voxel centres on both of its sides; the
-// start shell fixed the topology, the flow and the snaps only move the surface.
-struct Neighbourhood {
-  std::array<std::array<int, 26>, 27> adj26{};
-  std::array<int, 27> n26{};
-  std::array<std::array<int, 6>, 27> adj6{};
-  std::array<int, 27> n6{};
-  Neighbourhood() {
-    for (int a = 0; a < 27; ++a) {
-      const int ax = a % 3, ay = (a / 3) % 3, az = a / 9;
-      for (int b = 0; b < 27; ++b) {
-        if (b == a) continue;
-        const int dx = std::abs(b % 3 - ax), dy = std::abs((b / 3) % 3 - ay), dz = std::abs(b / 9 - az);
-        if (std::max({dx, dy, dz}) > 1) continue;
-        adj26[a][n26[a]++] = b;
-        if (dx + dy + dz == 1) adj6[a][n6[a]++] = b;
-      }
-    }
-  }
-};
-
-// Components of `set` (bit per neighbourhood index, centre 13 excluded) under 26- or
-// 6-adjacency; for 6-adjacency only voxels of the 18-neighbourhood count, and only the
-// components holding a face neighbour of the centre.
-int neighbourhood_components(std::uint32_t set, bool six) {
-  static const Neighbourhood nb;
-  set &= ~(1u << 13);
-  if (six) {
-    for (int a = 0; a < 27; ++a) {
-      const int dx = std::abs(a % 3 - 1), dy = std::abs((a / 3) % 3 - 1), dz = std::abs(a / 9 - 1);
-      if (dx + dy + dz == 3) set &= ~(1u << a);  // corners: not in the 18-neighbourhood
-    }
-  }
-  int count = 0;
-  std::uint32_t seen = 0;
-  std::array<int, 27> stack{};
-  for (int start = 0; start < 27; ++start) {
-    if (!((set >> start) & 1u) || ((seen >> start) & 1u)) continue;
-    if (six && !(start == 4 || start == 10 || start == 12 || start == 14 || start == 16 || start == 22)) continue;
-    ++count;
-    int top = 0;
-    stack[std::size_t(top++)] = start;
-    seen |= 1u << start;
-    while (top > 0) {
-      const int a = stack[std::size_t(--top)];
-      const int n = six ? nb.n6[std::size_t(a)] : nb.n26[std::size_t(a)];
-      for (int k = 0; k < n; ++k) {
-        const int b = six ? nb.adj6[std::size_t(a)][std::size_t(k)] : nb.adj26[std::size_t(a)][std::size_t(k)];
-        if (((set >> b) & 1u) && !((seen >> b) & 1u)) {
-          seen |= 1u << b;
-          stack[std::size_t(top++)] = b;
-        }
-      }
-    }
-  }
-  return count;
-}
-
-// `inside`: bit per neighbourhood index (dz + 1) 9 + (dy + 1) 3 + dx + 1.
-bool simple_voxel(std::uint32_t inside) {
-  const std::uint32_t outside = ~inside & ((1u << 27) - 1u);
-  return neighbourhood_components(inside, false) == 1 && neighbourhood_components(outside, true) == 1 &&
-         neighbourhood_components(inside, true) == 1 && neighbourhood_components(outside, false) == 1;
-}
-
-// Whether one of the 12 faces through the centre voxel (sign `centre`, neighbours `inside`)
-// has alternating signs: the marching cubes decide those by value (asymptotic decider), so
-// a flip that makes or unmakes one is not covered by the fixed-adjacency simple test.
-bool ambiguous_face_at_centre(std::uint32_t inside, bool centre) {
-  auto in = [&](int dx, int dy, int dz) {
-    return (dx | dy | dz) == 0 ? centre : bool((inside >> ((dz + 1) * 9 + (dy + 1) * 3 + dx + 1)) & 1u);
-  };
-  static constexpr int kPlanes[3][2][3] = {{{1, 0, 0}, {0, 1, 0}}, {{1, 0, 0}, {0, 0, 1}}, {{0, 1, 0}, {0, 0, 1}}};
-  for (const auto& plane : kPlanes)
-    for (int sa = -1; sa <= 1; sa += 2)
-      for (int sb = -1; sb <= 1; sb += 2) {
-        const int ax = sa * plane[0][0], ay = sa * plane[0][1], az = sa * plane[0][2];
-        const int bx = sb * plane[1][0], by = sb * plane[1][1], bz = sb * plane[1][2];
-        const bool a = in(ax, ay, az), b = in(bx, by, bz), d = in(ax + bx, ay + by, az + bz);
-        if (d == centre && a != centre && b != centre) return true;
-      }
-  return false;
-}
-
-// Keeps the topology of `before`'s inside set: `values` (active-voxel order of `after`, a band
-// on the same grid) may flip the sign of a voxel of `before` only where the flip is simple;
-// flips are taken one by one in brick order, repeated while some become simple, and the
-// others keep their old sign at +-eps. Serial (the flips are few, all at the front):
-// deterministic. Returns the number of flips refused.
-std::uint64_t keep_topology(const NarrowBand& before, const NarrowBand& after, std::vector<float>& values, double eps,
-                            const PointIndex* index = nullptr, double free_distance = 0.0) {
-  struct Candidate {
-    Coord c;
-    std::size_t slot;
-  };
-  // Sign changes, found per brick (TBB) and kept in brick order.
-  std::vector<std::vector<Candidate>> per_brick(after.brick_count());
-  for_each_active_parallel(after, before, 16, [&](BandAccessor& acc, std::uint32_t b, const Coord& c, float, std::size_t i) {
-    if ((values[i] < 0.0f) != acc.is_inside(c)) per_brick[b].push_back({c, i});
-  });
-  std::vector<Candidate> pending;
-  for (const auto& list : per_brick) pending.insert(pending.end(), list.begin(), list.end());
-  BandAccessor old_acc(before);
-  if (pending.empty()) return 0;
-  auto key = [](const Coord& c) {
-    return (std::uint64_t(std::uint32_t(c.x) & 0x1fffffu) << 42) | (std::uint64_t(std::uint32_t(c.y) & 0x1fffffu) << 21) |
-           std::uint64_t(std::uint32_t(c.z) & 0x1fffffu);
-  };
-  std::unordered_map<std::uint64_t, bool> flipped;  // current sign of the voxels flipped so far
-  auto inside_now = [&](const Coord& c) {
-    const auto it = flipped.find(key(c));
-    return it != flipped.end() ? it->second : old_acc.is_inside(c);
-  };
-  bool progress = true;
-  while (progress && !pending.empty()) {
-    progress = false;
-    std::vector<Candidate> rest;
-    for (const Candidate& cand : pending) {
-      std::uint32_t inside = 0;
-      for (int dz = -1; dz <= 1; ++dz)
-        for (int dy = -1; dy <= 1; ++dy)
-          for (int dx = -1; dx <= 1; ++dx)
-            if ((dx | dy | dz) != 0 && inside_now(cand.c + Coord{dx, dy, dz}))
-              inside |= 1u << ((dz + 1) * 9 + (dy + 1) * 3 + dx + 1);
-      const bool to_inside = values[cand.slot] < 0.0f;
-      if ((simple_voxel(inside) && !ambiguous_face_at_centre(inside, !to_inside) && !ambiguous_face_at_centre(inside, to_inside)) ||
-          (index != nullptr && index->nearest(after.world(cand.c)).distance > free_distance)) {
-        flipped[key(cand.c)] = values[cand.slot] < 0.0f;
-        progress = true;
-      } else {
-        rest.push_back(cand);
-      }
-    }
-    pending.swap(rest);
-  }
-  for (const Candidate& cand : pending) values[cand.slot] = float(old_acc.is_inside(cand.c) ? -eps : eps);
-  return pending.size();
-}
-
-// The marching cubes join or separate the two inside corners of an ambiguous face (signs
-// alternating round it) by the asymptotic decider: joined when v00 v11 > v10 v01 for the
-// inside diagonal (00, 11). A change of values without any sign change can therefore add a
-// handle or cut a thin part (measured: the snaps grew the bunny's ear handles with every
-// sign change simple). So where a face is ambiguous with the same signs before and after,
-// its decision must not change: the four corners of a face whose decision changed go back
-// to their values in `before` (same signs), repeated until no face changes (each round only
-// restores old values, so it ends). Returns the number of voxels restored. Serial over the
-// few ambiguous faces: deterministic.
-std::uint64_t keep_face_decisions(const NarrowBand& before, const NarrowBand& after, std::vector<float>& values) {
-  static constexpr Coord kAxes[3][2] = {{{1, 0, 0}, {0, 1, 0}}, {{1, 0, 0}, {0, 0, 1}}, {{0, 1, 0}, {0, 0, 1}}};
-  // joined(): +1 inside diagonal joined, -1 separated, 0 not ambiguous.
-  auto decision = [](double v00, double v10, double v11, double v01) {
-    const bool i00 = v00 < 0, i10 = v10 < 0, i11 = v11 < 0, i01 = v01 < 0;
-    if (i00 != i11 || i10 != i01 || i00 == i10) return 0;
-    const double inside = i00 ? v00 * v11 : v10 * v01, outside = i00 ? v10 * v01 : v00 * v11;
-    return inside > outside ? 1 : -1;
-  };
-  struct Face {
-    std::array<std::size_t, 4> slot;
-    std::array<double, 4> old;
-    int old_decision;
-  };
-  // Only faces ambiguous both before and after matter, and a corner of a face ambiguous after
-  // has an edge neighbour of the other sign, so it lies within about a voxel of the front:
-  // the voxels farther than 1.5 voxels after are skipped. Restoring keeps every sign, so a
-  // face whose signs do not alternate now never will. Collected per brick (TBB), kept in
-  // brick order.
-  const float near = float(1.5 * after.voxel_size());
-  std::vector<std::vector<Face>> per_brick(after.brick_count());
-  tbb::parallel_for(tbb::blocked_range<std::uint32_t>(0, std::uint32_t(after.brick_count()), 16),
-                    [&](const tbb::blocked_range<std::uint32_t>& r) {
-    BandAccessor old_acc(before), acc(after);
-    auto slot_of = [&](const Coord& c) -> std::size_t {
-      const std::uint32_t b = acc.locate(brick_of(c));
-      if (b == kNoBrick) return std::size_t(-1);
-      const Brick& br = after.bricks()[b];
-      const int n = local_index(c);
-      return br.active.test(n) ? br.value_offset + br.slot(n) : std::size_t(-1);
-    };
-    for (std::uint32_t b = r.begin(); b != r.end(); ++b) {
-      std::size_t slot = after.bricks()[b].value_offset;
-      after.for_each_active_in_brick(b, [&](const Coord& c, float) {
-        const std::size_t self = slot++;
-        if (std::abs(values[self]) > near) return;
-        for (const auto& axes : kAxes) {
-          const std::array<Coord, 4> corner{c, c + axes[0], c + axes[0] + axes[1], c + axes[1]};
-          Face f;
-          f.slot[0] = self;
-          f.slot[2] = slot_of(corner[2]);  // the diagonal first: it rules out most faces
-          if (f.slot[2] == std::size_t(-1) || (values[self] < 0.0f) != (values[f.slot[2]] < 0.0f)) continue;
-          f.slot[1] = slot_of(corner[1]);
-          f.slot[3] = slot_of(corner[3]);
-          if (f.slot[1] == std::size_t(-1) || f.slot[3] == std::size_t(-1) ||
-              decision(values[f.slot[0]], values[f.slot[1]], values[f.slot[2]], values[f.slot[3]]) == 0)
-            continue;
-          bool ok = true;
-          for (int k = 0; k < 4 && ok; ++k) {
-            const std::optional<float> v = old_acc.probe(corner[std::size_t(k)]);
-            ok = v.has_value();
-            if (ok) f.old[std::size_t(k)] = double(*v);
-          }
-          if (!ok) continue;
-          f.old_decision = decision(f.old[0], f.old[1], f.old[2], f.old[3]);
-          if (f.old_decision != 0) per_brick[b].push_back(f);
-        }
-      });
-    }
-  });
-  std::vector<Face> faces;
-  for (const auto& list : per_brick) faces.insert(faces.end(), list.begin(), list.end());
-  std::uint64_t restored = 0;
-  for (bool changed = true; changed;) {
-    changed = false;
-    for (const Face& f : faces) {
-      const std::array<double, 4> v{double(values[f.slot[0]]), double(values[f.slot[1]]), double(values[f.slot[2]]),
-                                    double(values[f.slot[3]])};
-      const int d = decision(v[0], v[1], v[2], v[3]);
-      if (d == 0 || d == f.old_decision) continue;  // signs changed (a simple flip), or same decision
-      for (int k = 0; k < 4; ++k) {
-        if (values[f.slot[std::size_t(k)]] != float(f.old[std::size_t(k)])) {
-          values[f.slot[std::size_t(k)]] = float(f.old[std::size_t(k)]);
-          ++restored;
-          changed = true;
-        }
-      }
-    }
-  }
-  return restored;
-}
-
 // Components the data do not support: a component of the inside or outside voxel set
 // (not the exterior, not the inside component with the largest front) whose front voxels have a point
 // within `support` for less than kMinSupport of them. They arise on the coarse level where
@@ -849,8 +598,14 @@ SnapPass snap_to_fits(NarrowBand& band, const PointIndex& index, const SnapSetti
     change[b] += std::abs(target - u) / h;
     ++count[b];
   });
-  const std::uint64_t refused = settings.guard ? keep_topology(band, band, next, 1e-3 * h) : 0;
-  if (settings.guard) keep_face_decisions(band, band, next);
+  std::uint64_t refused = 0;
+  if (settings.guard) {
+    TopologyGuardOptions guard;
+    guard.eps = 1e-3 * h;
+    TopologyGuardResult kept = guard_topology(band, band, std::move(next), guard);
+    next = std::move(kept.values);
+    refused = kept.refused_flips;
+  }
   band.swap_values(next);
   SnapPass pass;
   pass.refused = refused;
@@ -941,7 +696,7 @@ ReconstructionResult reconstruct_surface(const std::vector<Vec3d>& input, const 
       ev.drift_tolerance = 0.1;  // the speed is constant along normals near the data: rare
       ev.progress.cancel = o.progress.cancel;
       // One step per evolve call: between steps, sign changes that are not simple are
-      // refused and ambiguous faces keep their decision (keep_topology): the start shell's
+      // refused and ambiguous faces keep their decision (grid/topology_guard.hpp): the start shell's
       // topology is the result's (a part thinner than a coarse voxel, the bunny's ears,
       // otherwise broke off or grew handles depending on the sample set).
       const auto t_flow = Clock::now();
@@ -965,10 +720,14 @@ ReconstructionResult reconstruct_surface(const std::vector<Vec3d>& input, const 
         if (r.stop == evolve::StopReason::Cancelled) throw Error(ErrorCode::Cancelled, "reconstruct", "operation cancelled");
         if (r.stop == evolve::StopReason::NonFinite) throw Error(ErrorCode::NonFinite, "reconstruct", r.message);
         stage.seconds_redistance += r.seconds.redistance;
-        std::vector<float> values(r.band.values().begin(), r.band.values().end());
-        const std::uint64_t refused = keep_topology(band, r.band, values, 1e-3 * h, &index, o.free_distance * h);
-        keep_face_decisions(band, r.band, values);
-        r.band.swap_values(values);
+        TopologyGuardOptions guard;
+        guard.eps = 1e-3 * h;
+        const double free_distance = o.free_distance * h;
+        guard.free = [&](const Coord& c) { return index.nearest(r.band.world(c)).distance > free_distance; };
+        TopologyGuardResult kept =
+            guard_topology(band, r.band, std::vector<float>(r.band.values().begin(), r.band.values().end()), guard);
+        const std::uint64_t refused = kept.refused_flips;
+        r.band.swap_values(kept.values);
         if (refused > 0) {
           // Refused voxels hold the front where the band upkeep had moved on: redistance on
           // the domain grown by one voxel, as after a snap.

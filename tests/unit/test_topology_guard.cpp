@@ -1,0 +1,113 @@
+// guard_topology (grid/topology_guard.hpp): sign changes that would change the topology of
+// the inside set are refused, simple ones pass, and ambiguous faces keep their decision.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "grid/build_from_sdf.hpp"
+#include "grid/sign_components.hpp"
+#include "grid/topology_guard.hpp"
+
+namespace levelset {
+namespace {
+
+NarrowBand band_of(const std::function<double(const Vec3d&)>& sdf, double lo, double hi, double h) {
+  SdfBuildOptions o;
+  o.frame = GridFrame{h, Vec3d{0, 0, 0}, 3.0};
+  BBox b;
+  b.min = {lo, lo, lo};
+  b.max = {hi, hi, hi};
+  return build_from_sdf(sdf, b, o).band;
+}
+
+std::vector<float> values_of(const NarrowBand& band) { return {band.values().begin(), band.values().end()}; }
+
+std::size_t inside_components(const NarrowBand& band) {
+  std::size_t n = 0;
+  for (const SignComponent& c : sign_components(band).components) n += c.inside ? 1 : 0;
+  return n;
+}
+
+TEST(SimpleVoxel, FlatFaceIsSimpleAndIsolatedVoxelOrTunnelIsNot) {
+  auto bit = [](int dx, int dy, int dz) { return 1u << ((dz + 1) * 9 + (dy + 1) * 3 + dx + 1); };
+  std::uint32_t below = 0;  // the half space z < 0 inside
+  for (int dy = -1; dy <= 1; ++dy)
+    for (int dx = -1; dx <= 1; ++dx) below |= bit(dx, dy, -1);
+  EXPECT_TRUE(simple_voxel(below));
+  EXPECT_FALSE(simple_voxel(0u));                            // a lone voxel: flipping deletes a component
+  EXPECT_FALSE(simple_voxel(bit(0, 0, -1) | bit(0, 0, 1)));  // the middle of a 1-voxel rod: flipping cuts it
+  std::uint32_t ring = 0;  // a ring round the centre in the z = 0 plane: filling it closes a hole
+  for (int dy = -1; dy <= 1; ++dy)
+    for (int dx = -1; dx <= 1; ++dx)
+      if (dx != 0 || dy != 0) ring |= bit(dx, dy, 0);
+  EXPECT_FALSE(simple_voxel(ring));
+}
+
+TEST(TopologyGuard, ThinSlabIsNotCutButMayMoveWhereSimple) {
+  // A slab one voxel thick (|z| < 0.5 h) proposed to move wholly outside: every flip would cut
+  // or delete it, so all sign changes that would remove its last voxel row are refused and the
+  // slab stays one component.
+  const double h = 0.1;
+  const NarrowBand slab = band_of([&](const Vec3d& p) { return std::max(std::abs(p.z) - 0.5 * h, std::max(std::abs(p.x), std::abs(p.y)) - 1.0); }, -1.5, 1.5, h);
+  ASSERT_EQ(inside_components(slab), 1u);
+  std::vector<float> proposed = values_of(slab);
+  for (float& v : proposed) v = std::abs(v) + 0.01f;  // everything outside
+  TopologyGuardOptions o;
+  o.eps = 1e-3 * h;
+  TopologyGuardResult r = guard_topology(slab, slab, proposed, o);
+  EXPECT_GT(r.refused_flips, 0u);
+  NarrowBand kept = slab;
+  kept.swap_values(r.values);
+  EXPECT_EQ(inside_components(kept), 1u);
+  // The same proposal with every voxel free: the slab vanishes.
+  o.free = [](const Coord&) { return true; };
+  r = guard_topology(slab, slab, proposed, o);
+  EXPECT_EQ(r.refused_flips, 0u);
+  NarrowBand gone = slab;
+  gone.swap_values(r.values);
+  EXPECT_EQ(inside_components(gone), 0u);
+}
+
+TEST(TopologyGuard, GrowingABallIsSimpleEverywhere) {
+  // A ball grown by half a voxel: every flip is simple (outside voxels next to the front join
+  // the inside one shell at a time), none is refused.
+  const NarrowBand ball = band_of([](const Vec3d& p) { return length(p) - 0.6; }, -1.0, 1.0, 0.1);
+  std::vector<float> proposed = values_of(ball);
+  for (float& v : proposed) v -= 0.05f;
+  TopologyGuardOptions o;
+  o.eps = 1e-4;
+  const TopologyGuardResult r = guard_topology(ball, ball, proposed, o);
+  EXPECT_EQ(r.refused_flips, 0u);
+  EXPECT_EQ(r.values, proposed);
+}
+
+TEST(TopologyGuard, AmbiguousFaceKeepsItsDecision) {
+  // Two balls whose insides meet only across a face diagonal at the origin's face: before,
+  // the face's inside corners are joined (v00 v11 > v10 v01); the proposal keeps all signs but
+  // makes the outside corners deeper, which would separate them. The guard restores the face.
+  const double h = 1.0;
+  NarrowBand band = band_of([](const Vec3d& p) {
+    const double a = length(p - Vec3d{-0.7, -0.7, 0}) - 0.8, b = length(p - Vec3d{1.7, 1.7, 0}) - 0.8;
+    return std::min(a, b);
+  }, -3, 4, h);
+  // Voxels (0,0,0) and (1,1,0) inside, (1,0,0) and (0,1,0) outside: set them explicitly.
+  band.set_value({0, 0, 0}, -0.5f);
+  band.set_value({1, 1, 0}, -0.5f);
+  band.set_value({1, 0, 0}, 0.2f);
+  band.set_value({0, 1, 0}, 0.2f);
+  std::vector<float> proposed = values_of(band);
+  NarrowBand changed = band;
+  changed.set_value({1, 0, 0}, 0.9f);
+  changed.set_value({0, 1, 0}, 0.9f);
+  proposed = values_of(changed);
+  const TopologyGuardResult r = guard_topology(band, band, proposed, TopologyGuardOptions{});
+  EXPECT_GT(r.restored_values, 0u);
+  NarrowBand kept = band;
+  std::vector<float> values = r.values;
+  kept.swap_values(values);
+  EXPECT_FLOAT_EQ(*kept.value({1, 0, 0}), 0.2f);
+  EXPECT_FLOAT_EQ(*kept.value({0, 1, 0}), 0.2f);
+}
+
+}  // namespace
+}  // namespace levelset
