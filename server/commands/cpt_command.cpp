@@ -41,7 +41,6 @@ int run_cpt(const CptArgs& args) {
               args.output.c_str(), human_bytes(written.file_bytes).c_str());
 
   Stats stats("cpt", cpt.band);
-  auto secs = [](auto a, auto b) { return std::chrono::duration<double>(b - a).count(); };
   stats.seconds["read"] = secs(t0, t1);
   stats.seconds["orient"] = cpt.seconds.orient;
   stats.seconds["bin"] = cpt.seconds.bin;

@@ -23,7 +23,6 @@ struct CsgArgs {
 
 int run_csg(const CsgArgs& args) {
   using Clock = std::chrono::steady_clock;
-  auto secs = [](auto x, auto y) { return std::chrono::duration<double>(y - x).count(); };
   const auto t0 = Clock::now();
   const LsgReadResult a = load_lsg(args.a), b = load_lsg(args.b);
   const auto t1 = Clock::now();
@@ -44,10 +43,7 @@ int run_csg(const CsgArgs& args) {
   const apps::ShapeMeasures m = apps::measure_shape(r.band);
   print_shape(out, "result", m);
   Stats stats("csg", r.band);
-  stats.seconds["read"] = secs(t0, t1);
-  stats.seconds["csg"] = secs(t1, t2);
-  stats.seconds["write"] = secs(t2, t3);
-  stats.seconds["total"] = secs(t0, t3);
+  stats.set_phases("csg", t0, t1, t2, t3);
   stats.extra["operation"] = args.op;
   stats.extra["voxel_size"] = r.band.voxel_size();
   stats.extra["half_width"] = r.band.half_width();

@@ -58,7 +58,6 @@ int run_evolve(const EvolveArgs& args) {
   const auto t2 = std::chrono::steady_clock::now();
   const LsgWriteResult written = save_lsg(result.band, args.output);
   const auto t3 = std::chrono::steady_clock::now();
-  auto secs = [](auto a, auto b) { return std::chrono::duration<double>(b - a).count(); };
 
   std::fprintf(out, "%s: %d steps to t = %.6g (%s), %zu -> %zu active voxels, %d redistances, %.3f s -> %s (%s)\n",
                args.input.c_str(), result.steps, result.time, evolve::to_string(result.stop).data(), in.band.active_voxel_count(),

@@ -26,7 +26,6 @@ struct FairArgs {
 
 int run_fair(const FairArgs& args) {
   using Clock = std::chrono::steady_clock;
-  auto secs = [](auto a, auto b) { return std::chrono::duration<double>(b - a).count(); };
   if ((args.time > 0) == (args.steps > 0))
     throw Error(ErrorCode::InvalidArgument, "fair", "give exactly one of --time and --steps");
   const auto t0 = Clock::now();
@@ -47,10 +46,7 @@ int run_fair(const FairArgs& args) {
   print_shape(out, "before", r.before);
   print_shape(out, "after", r.after);
   Stats stats("fair", r.band);
-  stats.seconds["read"] = secs(t0, t1);
-  stats.seconds["fair"] = secs(t1, t2);
-  stats.seconds["write"] = secs(t2, t3);
-  stats.seconds["total"] = secs(t0, t3);
+  stats.set_phases("fair", t0, t1, t2, t3);
   stats.extra["flow"] = args.flow;
   stats.extra["steps"] = r.steps;
   stats.extra["time"] = r.time;

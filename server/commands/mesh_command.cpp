@@ -32,7 +32,6 @@ int run_mesh(const MeshArgs& args) {
   write_mesh(surface.mesh, args.output);
   const auto t3 = std::chrono::steady_clock::now();
   const MeshMeasures m = measure_mesh(surface.mesh);
-  auto secs = [](auto a, auto b) { return std::chrono::duration<double>(b - a).count(); };
 
   std::fprintf(summary_stream(args.stats), "%s: %zu vertices, %zu triangles (%s, iso %g), %s, %.3f s -> %s\n",
                args.input.c_str(), surface.mesh.vertices.size(), surface.mesh.triangles.size(),
@@ -40,10 +39,7 @@ int run_mesh(const MeshArgs& args) {
                m.watertight && m.manifold ? "watertight and manifold" : "open or non-manifold",
                secs(t1, t2), args.output.c_str());
   Stats stats("mesh", in.band);
-  stats.seconds["read"] = secs(t0, t1);
-  stats.seconds["extract"] = secs(t1, t2);
-  stats.seconds["write"] = secs(t2, t3);
-  stats.seconds["total"] = secs(t0, t3);
+  stats.set_phases("extract", t0, t1, t2, t3);
   stats.extra["method"] = args.method;
   stats.extra["iso"] = args.iso;
   stats.extra["vertices"] = surface.mesh.vertices.size();

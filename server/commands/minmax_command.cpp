@@ -25,7 +25,6 @@ struct MinMaxArgs {
 
 int run_minmax(const MinMaxArgs& args) {
   using Clock = std::chrono::steady_clock;
-  auto secs = [](auto a, auto b) { return std::chrono::duration<double>(b - a).count(); };
   const auto t0 = Clock::now();
   const LsgReadResult in = load_lsg(args.input);
   const auto t1 = Clock::now();
@@ -45,10 +44,7 @@ int run_minmax(const MinMaxArgs& args) {
   print_shape(out, "before", r.before);
   print_shape(out, "after", r.after);
   Stats stats("minmax", r.band);
-  stats.seconds["read"] = secs(t0, t1);
-  stats.seconds["minmax"] = secs(t1, t2);
-  stats.seconds["write"] = secs(t2, t3);
-  stats.seconds["total"] = secs(t0, t3);
+  stats.set_phases("minmax", t0, t1, t2, t3);
   stats.extra["radius"] = args.radius;
   stats.extra["tolerance"] = args.tolerance;
   stats.extra["steps"] = r.steps;

@@ -32,7 +32,6 @@ evolve::Scheme offset_scheme(const std::string& s) {
 
 int run_offset(const OffsetArgs& args) {
   using Clock = std::chrono::steady_clock;
-  auto secs = [](auto a, auto b) { return std::chrono::duration<double>(b - a).count(); };
   const auto t0 = Clock::now();
   const LsgReadResult in = load_lsg(args.input);
   const auto t1 = Clock::now();

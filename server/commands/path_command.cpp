@@ -60,7 +60,6 @@ int run_path(const PathArgs& args) {
   const auto t1 = std::chrono::steady_clock::now();
   write_file_atomically(args.output, path_text(r, medium.grid, from, to));
   const auto t2 = std::chrono::steady_clock::now();
-  auto secs = [](auto a, auto b) { return std::chrono::duration<double>(b - a).count(); };
 
   const apps::DenseGrid& g = medium.grid;
   std::fprintf(summary_stream(args.stats),

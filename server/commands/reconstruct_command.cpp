@@ -68,18 +68,14 @@ int run(const ReconstructArgs& a) {
   write_mesh(r.mesh, a.output);
   if (!a.lsg.empty()) save_lsg(r.band, a.lsg);
   const auto t3 = std::chrono::steady_clock::now();
-  auto secs = [](auto x, auto y) { return std::chrono::duration<double>(y - x).count(); };
 
   std::fprintf(out, "%s: %zu points -> %llu triangles, genus %g, %s, area %.6g, volume %.6g, %.3f s -> %s\n",
                a.input.c_str(), points.size(), (unsigned long long)r.measures.faces, r.measures.genus,
                r.measures.watertight ? "watertight" : "NOT watertight", r.measures.area, r.measures.volume, secs(t1, t2),
                a.output.c_str());
   Stats stats("reconstruct", r.band);
-  stats.seconds["read"] = secs(t0, t1);
-  stats.seconds["reconstruct"] = secs(t1, t2);
+  stats.set_phases("reconstruct", t0, t1, t2, t3);
   stats.seconds["mesh"] = r.seconds_mesh;
-  stats.seconds["write"] = secs(t2, t3);
-  stats.seconds["total"] = secs(t0, t3);
   stats.extra["levels"] = jobs::stages_json(r.stages);
   stats.extra["points"] = points.size();
   stats.extra["voxel_size"] = r.voxel_size;

@@ -21,16 +21,12 @@ int run_redistance(const RedistanceArgs& args) {
   const auto t2 = std::chrono::steady_clock::now();
   const LsgWriteResult written = save_lsg(result.band, args.output);
   const auto t3 = std::chrono::steady_clock::now();
-  auto secs = [](auto a, auto b) { return std::chrono::duration<double>(b - a).count(); };
 
   std::fprintf(summary_stream(args.stats), "%s: %zu -> %zu active voxels (%s), %.3f s -> %s (%s)\n", args.input.c_str(),
               in.band.active_voxel_count(), result.band.active_voxel_count(), args.method.c_str(),
               secs(t1, t2), args.output.c_str(), human_bytes(written.file_bytes).c_str());
   Stats stats("redistance", result.band);
-  stats.seconds["read"] = secs(t0, t1);
-  stats.seconds["redistance"] = secs(t1, t2);
-  stats.seconds["write"] = secs(t2, t3);
-  stats.seconds["total"] = secs(t0, t3);
+  stats.set_phases("redistance", t0, t1, t2, t3);
   stats.extra["method"] = args.method;
   stats.extra["order"] = args.order;
   stats.extra["input_active_voxels"] = in.band.active_voxel_count();

@@ -16,6 +16,15 @@ Stats::Stats(std::string op_name, const NarrowBand& band)
       active_voxels(band.active_voxel_count()),
       bytes(band.memory_bytes()) {}
 
+void Stats::set_phases(const std::string& work, std::chrono::steady_clock::time_point t0,
+                       std::chrono::steady_clock::time_point t1, std::chrono::steady_clock::time_point t2,
+                       std::chrono::steady_clock::time_point t3) {
+  seconds["read"] = secs(t0, t1);
+  seconds[work] = secs(t1, t2);
+  seconds["write"] = secs(t2, t3);
+  seconds["total"] = secs(t0, t3);
+}
+
 nlohmann::json Stats::to_json() const {
   nlohmann::json j = extra;
   j["op"] = op;

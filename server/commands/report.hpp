@@ -6,6 +6,7 @@
 // to a file, or to stdout for "-".
 #pragma once
 
+#include <chrono>
 #include <cstdint>
 #include <cstdio>
 #include <string>
@@ -15,6 +16,11 @@
 #include "grid/narrow_band.hpp"
 
 namespace levelset::cli {
+
+// Seconds from a to b.
+inline double secs(std::chrono::steady_clock::time_point a, std::chrono::steady_clock::time_point b) {
+  return std::chrono::duration<double>(b - a).count();
+}
 
 struct Stats {
   // A record for `op` about `band`: threads in use, its active voxels and bytes.
@@ -26,6 +32,10 @@ struct Stats {
   int threads = 0;
   std::uint64_t active_voxels = 0;
   std::uint64_t bytes = 0;
+
+  // The usual phases: "read" t0..t1, `work` t1..t2, "write" t2..t3 and "total" t0..t3.
+  void set_phases(const std::string& work, std::chrono::steady_clock::time_point t0, std::chrono::steady_clock::time_point t1,
+                  std::chrono::steady_clock::time_point t2, std::chrono::steady_clock::time_point t3);
 
   nlohmann::json to_json() const;
 };

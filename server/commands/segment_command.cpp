@@ -97,7 +97,6 @@ int run_segment(const SegmentArgs& a) {
     write_file_atomically(a.mask, bytes);
   }
   const auto t3 = std::chrono::steady_clock::now();
-  auto secs = [](auto x, auto y) { return std::chrono::duration<double>(y - x).count(); };
   std::fprintf(out,
                "%s: %lld x %lld x %lld %s image; %d steps to t = %.5g (%s, last motion %.3g voxels); volume %.6g, "
                "area %.6g, %llu components, genus %g, %s; %.3f s -> %s (%s)\n",

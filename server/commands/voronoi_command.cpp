@@ -71,7 +71,6 @@ int run_voronoi(const VoronoiArgs& args) {
     save_nrrd(args.distance, frame, std::span<const float>(d));
   }
   const auto t2 = std::chrono::steady_clock::now();
-  auto secs = [](auto a, auto b) { return std::chrono::duration<double>(b - a).count(); };
 
   std::fprintf(summary_stream(args.stats),
                "voronoi: %zu seeds, %zu regions, grid %dx%dx%d h %.4g, %llu blocked, %llu unreached; %.3f s -> %s\n",
