@@ -3,6 +3,7 @@
 // with Gaussian noise) on a built-in shape or a mesh; then the true surface is known and
 // the stats hold the accuracy: symmetric mean (Chamfer) and Hausdorff distances between the
 // result and the truth, in world units, voxels and bounding-box diagonals.
+// Every run also reports the fit: the distances from the input points to the result.
 //   input { points = FILE (.xyz .xyzn .pwn .ply)  |  sample = knot  |  sample_mesh = FILE
 //           count = 20000  noise = 0 (x the bbox diagonal)  seed = 1 }
 //   reconstruct { levels = 3  neighbors = 8  curvature_weight = 0.3  max_steps = 120
@@ -93,6 +94,20 @@ void run_reconstruct_job(JobContext& ctx) {
                                 {"levels", stages_json(result.stages)}};
   ctx.stats()["mesh"] = measures_json(result.measures);
 
+  // Fit to the data, with or without a true surface: the distances from the input points to
+  // the result (for noisy points about the noise; a scan's outliers show in the maximum).
+  const apps::MeshDistance ours_distance(result.mesh);
+  {
+    const apps::OneSidedDistance f = apps::distances_to(
+        points, [&](const Vec3d& p) { return ours_distance.distance(p); }, ctx.options().progress);
+    ctx.stats()["fit"] = {{"mean", f.mean}, {"rms", f.rms}, {"max", f.max},
+                          {"mean_voxels", f.mean / result.voxel_size}, {"max_voxels", f.max / result.voxel_size}};
+    char line[160];
+    std::snprintf(line, sizeof line, "fit: the points lie %.3g voxel from the surface on average, %.3g at most",
+                  f.mean / result.voxel_size, f.max / result.voxel_size);
+    ctx.log(line);
+  }
+
   if (truth_distance) {
     // Accuracy against the true surface, from dense samples of both.
     apps::SurfaceSampleOptions dense;
@@ -101,7 +116,6 @@ void run_reconstruct_job(JobContext& ctx) {
     dense.progress = ctx.options().progress;
     const std::vector<Vec3d> ours = apps::sample_mesh_surface(result.mesh, dense);
     const std::vector<Vec3d> truth = shape ? apps::sample_shape_surface(*shape, dense) : apps::sample_mesh_surface(truth_mesh, dense);
-    const apps::MeshDistance ours_distance(result.mesh);
     const apps::SurfaceDistance d =
         apps::surface_distance(ours, truth_distance, truth, [&](const Vec3d& p) { return ours_distance.distance(p); },
                                ctx.options().progress);
