@@ -4,8 +4,10 @@
 #include <array>
 #include <cstdlib>
 #include <optional>
+#include <string>
 #include <unordered_map>
 
+#include "core/error.hpp"
 #include "grid/band_accessor.hpp"
 #include "grid/for_each_active_parallel.hpp"
 
@@ -248,6 +250,12 @@ std::uint64_t keep_face_decisions(const NarrowBand& before, const NarrowBand& af
 
 TopologyGuardResult guard_topology(const NarrowBand& before, const NarrowBand& after, std::vector<float> values,
                                    const TopologyGuardOptions& options) {
+  if (values.size() != after.active_voxel_count())
+    throw Error(ErrorCode::InvalidArgument, "guard_topology",
+                "got " + std::to_string(values.size()) + " values for " + std::to_string(after.active_voxel_count()) +
+                    " active voxels");
+  if (before.voxel_size() != after.voxel_size() || !(before.origin() == after.origin()))
+    throw Error(ErrorCode::InvalidArgument, "guard_topology", "the two bands are not on the same grid");
   TopologyGuardResult r;
   r.refused_flips = keep_topology(before, after, values, options.eps, options.free);
   r.restored_values = keep_face_decisions(before, after, values);

@@ -22,6 +22,8 @@
 //      sign change simple (measured on the bunny's ears in the reconstruction's snaps).
 // Output: TopologyGuardResult (the values, how many flips were refused, how many values were
 //   restored for face decisions).
+// Errors: Error{InvalidArgument} when values.size() is not after's active voxel count or the
+//   bands' voxel sizes or origins differ.
 // Cost: O(active voxels) scans (TBB) plus serial work on the sign changes and the ambiguous
 //   faces near the front (few). Deterministic for any thread count.
 // Why it exists: a part thinner than the voxel (the bunny's ears at a reconstruction's coarse

@@ -4,6 +4,7 @@
 
 #include <cmath>
 
+#include "core/error.hpp"
 #include "grid/build_from_sdf.hpp"
 #include "grid/sign_components.hpp"
 #include "grid/topology_guard.hpp"
@@ -107,6 +108,14 @@ TEST(TopologyGuard, AmbiguousFaceKeepsItsDecision) {
   kept.swap_values(values);
   EXPECT_FLOAT_EQ(*kept.value({1, 0, 0}), 0.2f);
   EXPECT_FLOAT_EQ(*kept.value({0, 1, 0}), 0.2f);
+}
+
+TEST(TopologyGuard, MismatchedInputsGiveTypedErrors) {
+  const NarrowBand ball = band_of([](const Vec3d& p) { return length(p) - 0.6; }, -1.0, 1.0, 0.1);
+  const NarrowBand finer = band_of([](const Vec3d& p) { return length(p) - 0.6; }, -1.0, 1.0, 0.05);
+  std::vector<float> short_values(ball.active_voxel_count() - 1, 1.0f);
+  EXPECT_THROW(guard_topology(ball, ball, short_values, {}), Error);
+  EXPECT_THROW(guard_topology(ball, finer, values_of(finer), {}), Error);
 }
 
 }  // namespace
