@@ -38,8 +38,9 @@
 //   stop_when once the mean front motion (|beta| dt over the voxels within one voxel of the
 //   front) is below tolerance voxels per step, or after max_steps.
 //   Finer levels, a snap: the band is resampled (trilinear) at half the voxel size; then
-//   snap_passes times: every voxel within 1.5 voxels of the front computes its front offset
-//   e = clamp(s - u, -h, h) from fits of the points near the voxel (point_distance.hpp
+//   snap_passes times: every voxel within 1 voxel of the front computes its front offset
+//   e = clamp(s - u, -h, h) from fits of the points near the voxel (the others within 1.5
+//   voxels, which also move, take their neighbours' mean e) (point_distance.hpp
 //   sheet_fit: the nearest points less those off the near sheet along the normal, so a part
 //   thinner than the neighbourhood is not flattened onto its middle plane), two of them:
 //   the plane (centroid) fit of the k nearest, with the curvature correction from the coarse
@@ -51,8 +52,13 @@
 //   and its 6 face neighbours (later passes refit only the voxels within 1 voxel of the front);
 //   noisy data take the plane offsets (lower variance), smoothed by round(4 sigma^2) (at most
 //   3) 3x3x3 box passes (sigma in this level's voxels), and each voxel moves by the mean e of
-//   its 3x3x3 neighbourhood (tangential averaging of the fits' noise). A voxel may change
-//   sign only next to the front (no new bubbles or handles), and the band is redistanced (fast sweeping, W)
+//   its 3x3x3 neighbourhood (tangential averaging of the fits' noise); once a level found the
+//   data noisy, the following levels take height fits over 48 (density / 0.15)^(3/4) points
+//   (density: points per final voxel^2 of front) with at most one smoothing pass instead. A
+//   voxel may change sign only next to the front and only where the flip keeps the topology
+//   (grid/topology_guard.hpp, also in the coarse flow except where no point lies within
+//   free_distance coarse voxels; components the data do not support are dropped after the
+//   flow: sign_components), and the band is redistanced (fast sweeping, W)
 //   on its domain grown by one voxel (the front moved by up to one voxel; without the growth
 //   the band lacked voxels near the front where it moved outward, and the next upsampling or
 //   the marching cubes left holes). This is the
@@ -66,8 +72,8 @@
 // Cost: coarsest level O(steps * band) plus its fits; finer levels O(snap_passes * (voxels
 //   within 1.5 h of the front * (max(k, 16) log N + a 6x6 solve) + band)) (fits and
 //   redistance); the coarsest level's dense start grid has (L / h_c + 2 pad)^3 voxels.
-//   bench_reconstruct, resolution 256, 2 shared cores: 1.6-2.3 s for 20k-100k points (the
-//   final level's second clean pass is ~0.5 s of it).
+//   bench_reconstruct, resolution 256, 2 shared cores: 1.8-4.8 s for 20k-100k points (noisy
+//   100k points: the density-sized height fits of up to 160 points are most of it).
 // Threading: TBB throughout; the result is identical for any thread count.
 // Errors (thrown): Error{InvalidArgument} for fewer than 4 points, all points equal, bad
 //   options (resolution < 2 (W + 2) + 8, both or neither of resolution / voxel_size,
