@@ -82,8 +82,10 @@ void PointIndex::within(const Vec3d& x, double radius, std::vector<std::pair<std
 double sample_gap(const PointIndex& index, int k, double quantile, std::size_t samples) {
   const std::size_t n = index.size();
   if (n < 2 || samples == 0) return 0.0;
-  const int want = std::clamp(k + 1, 2, std::min(kMaxNeighbors, int(n)));  // the point itself is its own nearest
-  const std::size_t stride = std::max<std::size_t>(1, n / samples);
+  if (!std::isfinite(quantile)) throw Error(ErrorCode::NonFinite, "sample_gap", "quantile is not finite");
+  // The point itself is its own nearest: k + 1 neighbours, at most the set and the query buffer.
+  const int want = int(std::clamp<std::size_t>(std::size_t(std::max(k, 1)) + 1, 2, std::min<std::size_t>(kMaxNeighbors, n)));
+  const std::size_t stride = std::max<std::size_t>(1, (n + samples - 1) / samples);
   std::array<std::uint32_t, kMaxNeighbors> idx{};
   std::array<double, kMaxNeighbors> d2{};
   std::vector<double> gaps;

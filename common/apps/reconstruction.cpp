@@ -136,6 +136,8 @@ void validate(const std::vector<Vec3d>& points, const ReconstructionOptions& o) 
   require(o.clean_final_passes >= 0 && o.clean_final_passes <= 16, "clean_final_passes must be in [0, 16]");
   require(o.tolerance > 0.0, "tolerance must be > 0");
   require(o.max_resolution >= 16, "max_resolution must be >= 16");
+  if (!std::isfinite(o.free_distance)) throw Error(ErrorCode::NonFinite, "reconstruct", "non-finite free_distance");
+  require(o.free_distance >= 0.0, "free_distance must be >= 0 coarse voxels");
 }
 
 // The band with its frame moved by `offset` and its half-width set to `half_width` voxels
@@ -602,6 +604,7 @@ SnapPass snap_to_fits(NarrowBand& band, const PointIndex& index, const SnapSetti
   if (settings.guard) {
     TopologyGuardOptions guard;
     guard.eps = 1e-3 * h;
+    guard.progress = progress;
     TopologyGuardResult kept = guard_topology(band, band, std::move(next), guard);
     next = std::move(kept.values);
     refused = kept.refused_flips;
@@ -722,6 +725,7 @@ ReconstructionResult reconstruct_surface(const std::vector<Vec3d>& input, const 
         stage.seconds_redistance += r.seconds.redistance;
         TopologyGuardOptions guard;
         guard.eps = 1e-3 * h;
+        guard.progress = o.progress;
         const double free_distance = o.free_distance * h;
         guard.free = [&](const Coord& c) { return index.nearest(r.band.world(c)).distance > free_distance; };
         TopologyGuardResult kept =
@@ -848,7 +852,7 @@ ReconstructionResult reconstruct_surface(const std::vector<Vec3d>& input, const 
                   static_cast<unsigned long long>(stage.height_fits),
                   stage.seconds_start, stage.seconds_fit, stage.seconds_flow, stage.seconds_redistance, stage.seconds);
     log(line);
-    if (o.log) {
+    if (o.log && o.log_topology) {
       // Debug aid: the topology of this level's zero level.
       MarchingCubesOptions mc;
       mc.progress = o.progress;

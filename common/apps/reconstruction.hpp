@@ -80,7 +80,8 @@
 //   half_width not in [2, 8], levels not in [1, 6], neighbors not in [1, 256], negative
 //   curvature weight, tolerance <= 0, max_steps < 1, snap_passes or clean_final_passes not in
 //   [0, 16],
-//   shell_offset not in [1, 16]);
+//   shell_offset not in [1, 16], negative free_distance; the start shell's offset raised to close the
+//   samples' gaps is capped at 16 coarse voxels);
 //   Error{NonFinite} for a non-finite point (naming it) or option; Error{LimitExceeded}
 //   when the final grid would exceed max_resolution voxels along a side or the coarsest
 //   level's dense grid 2^27 voxels; Error{Cancelled} through progress (checked between
@@ -120,6 +121,7 @@ struct ReconstructionOptions {
   int max_resolution = 4096;    // cap on the final grid's longest side (voxels)
   ProgressHook progress;
   std::function<void(const std::string&)> log;  // progress lines; empty: none
+  bool log_topology = false;    // with log: also each level's genus and components (a marching cubes per level)
 };
 
 struct ReconstructionStage {

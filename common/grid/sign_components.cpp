@@ -19,6 +19,8 @@ SignComponentsResult sign_components(const NarrowBand& band, const SignComponent
   for (int n : {options.inside_connectivity, options.outside_connectivity})
     if (n != 6 && n != 26)
       throw Error(ErrorCode::InvalidArgument, "sign_components", "connectivity must be 6 or 26, got " + std::to_string(n));
+  if (options.max_voxels > (std::uint64_t(1) << 32))
+    throw Error(ErrorCode::InvalidArgument, "sign_components", "max_voxels must be at most 2^32");
   SignComponentsResult result;
   IndexBox box = band.active_index_bounds();
   if (box.empty()) return result;
@@ -45,19 +47,20 @@ SignComponentsResult sign_components(const NarrowBand& band, const SignComponent
         }
   });
   result.label.assign(total, -1);
-  std::vector<std::size_t> stack;
+  std::vector<std::uint32_t> stack;  // box indices: under max_voxels <= 2^32
+  std::uint64_t visited = 0;
   for (std::size_t start = 0; start < total; ++start) {
     if (result.label[start] >= 0) continue;
-    if ((start & 0xfffff) == 0) options.progress.check("sign components");
     const std::int32_t id = std::int32_t(result.components.size());
     SignComponent comp;
     comp.inside = state[start] & kInside;
     const bool diagonals = (comp.inside ? options.inside_connectivity : options.outside_connectivity) == 26;
     result.label[start] = id;
-    stack.push_back(start);
+    stack.push_back(std::uint32_t(start));
     while (!stack.empty()) {
       const std::size_t n = stack.back();
       stack.pop_back();
+      if ((++visited & 0xfffff) == 0) options.progress.check("sign components");
       ++comp.voxels;
       if (!(state[n] & kActive)) comp.all_active = false;
       const long i = long(n % std::size_t(nx)), j = long((n / std::size_t(nx)) % std::size_t(ny)),
@@ -80,7 +83,7 @@ SignComponentsResult sign_components(const NarrowBand& band, const SignComponent
             if (taxicab > 1 && !diagonals) continue;
             if (result.label[m] < 0) {
               result.label[m] = id;
-              stack.push_back(m);
+              stack.push_back(std::uint32_t(m));
             }
           }
       if (front) comp.front.push_back(Coord{box.min.x + int(i), box.min.y + int(j), box.min.z + int(k)});

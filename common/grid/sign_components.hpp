@@ -13,9 +13,10 @@
 //   26, outside 6) is a consistent one: its components are those of the surface the marching
 //   cubes draw, up to the ambiguous faces and cubes they decide by value. 6 for both finds
 //   every piece that a decision by value may separate (each component then is a candidate).
-// Cost: O(box voxels) time, 5 bytes per box voxel. Threading: serial flood fills after a
+// Cost: O(box voxels) time; 5 bytes per box voxel plus the flood fill's stack (4 bytes per
+//   voxel of the largest component at most). Threading: serial flood fills after a
 //   TBB sign pass; deterministic.
-// Errors: Error{InvalidArgument} for a connectivity other than 6 or 26; Error{LimitExceeded} when the box exceeds options.max_voxels; Error{Cancelled}
+// Errors: Error{InvalidArgument} for a connectivity other than 6 or 26 or max_voxels over 2^32; Error{LimitExceeded} when the box exceeds options.max_voxels; Error{Cancelled}
 //   through progress.
 #pragma once
 
@@ -47,6 +48,7 @@ struct SignComponentsResult {
   IndexBox box;                       // active bounds grown by one voxel
   std::vector<std::int32_t> label;    // per box voxel (x fastest): index into components
   std::vector<SignComponent> components;
+  // Index of c in `label`; c must lie in box.
   std::size_t index_of(const Coord& c) const {
     const std::size_t nx = std::size_t(box.max.x - box.min.x + 1), ny = std::size_t(box.max.y - box.min.y + 1);
     return (std::size_t(c.z - box.min.z) * ny + std::size_t(c.y - box.min.y)) * nx + std::size_t(c.x - box.min.x);

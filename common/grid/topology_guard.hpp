@@ -12,20 +12,22 @@
 //      voxel). The marching cubes decide ambiguous faces by value (asymptotic decider), which
 //      follows neither fixed adjacency pair, so a flip must be simple for both (26, 6) and
 //      (6, 26) and may neither make nor unmake an ambiguous face at the voxel. Flips are taken
-//      one by one in brick order, repeated while some become simple; the others keep their old
+//      one by one in brick order, a refused one again after a neighbour flipped; the others keep their old
 //      sign at +-eps. options.free(c), when given and true, allows any flip at voxel c (where
 //      the caller wants topology to change, e.g. far from data).
-//   2. An ambiguous face (signs alternating round it) with the same signs before and after
-//      keeps its decision: where a change of values alone would join or separate its inside
+//   2. An ambiguous face (signs alternating round it) with the same four signs before and
+//      after keeps its decision (values are taken to be distances: faces are looked for
+//      among the voxels within 1.5 voxels of the zero level): where a change of values alone would join or separate its inside
 //      corners, its four corners go back to their values in `before` (same signs), repeated
 //      until no face changes. Why: a thin part otherwise gains a handle or breaks with every
 //      sign change simple (measured on the bunny's ears in the reconstruction's snaps).
 // Output: TopologyGuardResult (the values, how many flips were refused, how many values were
 //   restored for face decisions).
-// Errors: Error{InvalidArgument} when values.size() is not after's active voxel count or the
-//   bands' voxel sizes or origins differ.
-// Cost: O(active voxels) scans (TBB) plus serial work on the sign changes and the ambiguous
-//   faces near the front (few). Deterministic for any thread count.
+// Errors: Error{InvalidArgument} when values.size() is not after's active voxel count, the
+//   bands' voxel sizes or origins differ, or eps is not a positive number; Error{Cancelled}
+//   through options.progress.
+// Cost: O(active voxels) scans (TBB) plus serial work on the sign changes (each tested again
+//   only when a neighbour flipped: O(changes)) and the ambiguous faces near the front. Deterministic for any thread count.
 // Why it exists: a part thinner than the voxel (the bunny's ears at a reconstruction's coarse
 //   level, a thin sheet under noisy fits) otherwise breaks into pieces or grows handles when
 //   the front crosses voxel centres on both of its sides.
@@ -35,14 +37,16 @@
 #include <functional>
 #include <vector>
 
+#include "core/progress.hpp"
 #include "grid/coord.hpp"
 #include "grid/narrow_band.hpp"
 
 namespace levelset {
 
 struct TopologyGuardOptions {
-  double eps = 0.0;                        // world: |value| given to a refused flip's voxel
+  double eps = 0.0;                        // world, > 0: |value| given to a refused flip's voxel
   std::function<bool(const Coord&)> free;  // optional: flips allowed at any topology cost here
+  ProgressHook progress;                   // checked every 2^16 flip tests
 };
 
 struct TopologyGuardResult {

@@ -96,6 +96,13 @@ void run_reconstruct_job(JobContext& ctx) {
 
   // Fit to the data, with or without a true surface: the distances from the input points to
   // the result (for noisy points about the noise; a scan's outliers show in the maximum).
+  if (result.mesh.triangles.empty()) {
+    // Nothing to measure (MeshDistance needs triangles); the outputs are still written.
+    ctx.log("the reconstruction is empty: no fit or accuracy");
+    ctx.write_band(result.band);
+    ctx.write_mesh(result.mesh);
+    return;
+  }
   const apps::MeshDistance ours_distance(result.mesh);
   {
     const apps::OneSidedDistance f = apps::distances_to(

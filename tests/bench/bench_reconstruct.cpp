@@ -120,6 +120,7 @@ int main(int argc, char** argv) {
           o.guard_snaps = guard_snaps;
           if (free_distance >= 0.0) o.free_distance = free_distance;
           if (log_stages) o.log = [](const std::string& line) { std::fprintf(stderr, "  %s\n", line.c_str()); };
+          o.log_topology = log_stages;
           const auto t0 = std::chrono::steady_clock::now();
           const apps::ReconstructionResult r = apps::reconstruct_surface(points, o);
           const double ours_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();

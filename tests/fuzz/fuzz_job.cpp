@@ -27,15 +27,23 @@ namespace {
 
 constexpr auto kCancelAfter = std::chrono::milliseconds(250);
 
-// Scratch folders, made once per process: an empty base (inputs) and the outputs.
+// Scratch folders, made once per process and removed at its exit: an empty base (inputs) and
+// the outputs.
+struct Scratch {
+  std::filesystem::path dir;
+  Scratch() : dir(std::filesystem::temp_directory_path() / ("levelset_fuzz_job_" + std::to_string(::getpid()))) {
+    std::filesystem::create_directories(dir / "in");
+    std::filesystem::create_directories(dir / "out");
+  }
+  ~Scratch() {
+    std::error_code ignored;
+    std::filesystem::remove_all(dir, ignored);
+  }
+};
+
 const std::filesystem::path& scratch() {
-  static const std::filesystem::path dir = [] {
-    const auto d = std::filesystem::temp_directory_path() / ("levelset_fuzz_job_" + std::to_string(::getpid()));
-    std::filesystem::create_directories(d / "in");
-    std::filesystem::create_directories(d / "out");
-    return d;
-  }();
-  return dir;
+  static const Scratch s;
+  return s.dir;
 }
 
 // Cancels `token` after kCancelAfter unless stopped first.

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <optional>
 
 #include "core/error.hpp"
 #include "grid/build_from_sdf.hpp"
@@ -101,7 +102,9 @@ TEST(TopologyGuard, AmbiguousFaceKeepsItsDecision) {
   changed.set_value({1, 0, 0}, 0.9f);
   changed.set_value({0, 1, 0}, 0.9f);
   proposed = values_of(changed);
-  const TopologyGuardResult r = guard_topology(band, band, proposed, TopologyGuardOptions{});
+  TopologyGuardOptions o;
+  o.eps = 1e-3;
+  const TopologyGuardResult r = guard_topology(band, band, proposed, o);
   EXPECT_GT(r.restored_values, 0u);
   NarrowBand kept = band;
   std::vector<float> values = r.values;
@@ -113,9 +116,43 @@ TEST(TopologyGuard, AmbiguousFaceKeepsItsDecision) {
 TEST(TopologyGuard, MismatchedInputsGiveTypedErrors) {
   const NarrowBand ball = band_of([](const Vec3d& p) { return length(p) - 0.6; }, -1.0, 1.0, 0.1);
   const NarrowBand finer = band_of([](const Vec3d& p) { return length(p) - 0.6; }, -1.0, 1.0, 0.05);
+  auto code = [](auto&& call) -> std::optional<ErrorCode> {
+    try {
+      call();
+    } catch (const Error& e) {
+      return e.code();
+    }
+    return std::nullopt;
+  };
+  TopologyGuardOptions o;
+  o.eps = 1e-3;
   std::vector<float> short_values(ball.active_voxel_count() - 1, 1.0f);
-  EXPECT_THROW(guard_topology(ball, ball, short_values, {}), Error);
-  EXPECT_THROW(guard_topology(ball, finer, values_of(finer), {}), Error);
+  EXPECT_EQ(code([&] { guard_topology(ball, ball, short_values, o); }), ErrorCode::InvalidArgument);
+  EXPECT_EQ(code([&] { guard_topology(ball, finer, values_of(finer), o); }), ErrorCode::InvalidArgument);
+  // eps = 0 would give a refused inside voxel the value -0, which reads as outside.
+  EXPECT_EQ(code([&] { guard_topology(ball, ball, values_of(ball), TopologyGuardOptions{}); }), ErrorCode::InvalidArgument);
+}
+
+TEST(TopologyGuard, FreeFlipsOfAWholeFaceAreNotUndone) {
+  // Every corner of an alternating face flips (allowed: free): the face alternates about the
+  // other diagonal, its decision is no comparison with the old one, and no sign may be restored.
+  const NarrowBand band = band_of([](const Vec3d& p) { return length(p) - 0.6; }, -1.0, 1.0, 0.1);
+  NarrowBand checker = band;
+  checker.set_value({0, 0, 0}, -0.5f * 0.1f);
+  checker.set_value({1, 1, 0}, -0.5f * 0.1f);
+  checker.set_value({1, 0, 0}, 0.2f * 0.1f);
+  checker.set_value({0, 1, 0}, 0.2f * 0.1f);
+  NarrowBand swapped = checker;
+  swapped.set_value({0, 0, 0}, 0.5f * 0.1f);
+  swapped.set_value({1, 1, 0}, 0.5f * 0.1f);
+  swapped.set_value({1, 0, 0}, -0.2f * 0.1f);
+  swapped.set_value({0, 1, 0}, -0.2f * 0.1f);
+  TopologyGuardOptions o;
+  o.eps = 1e-4;
+  o.free = [](const Coord&) { return true; };
+  const TopologyGuardResult r = guard_topology(checker, checker, values_of(swapped), o);
+  EXPECT_EQ(r.refused_flips, 0u);
+  EXPECT_EQ(r.values, values_of(swapped));
 }
 
 }  // namespace
