@@ -8,7 +8,7 @@
 
 namespace levelset::apps {
 
-ImageVolume downsample_image(const ImageVolume& im, int f) {
+ImageVolume downsample_image(const ImageVolume& im, int f, const ProgressHook& progress) {
   if (f < 1 || f > im.nx || f > im.ny || f > im.nz)
     throw Error(ErrorCode::InvalidArgument, "downsample", "factor " + std::to_string(f) + " does not fit the image");
   ImageVolume out;
@@ -20,6 +20,7 @@ ImageVolume downsample_image(const ImageVolume& im, int f) {
   out.samples.assign(out.voxel_count(), 0.0f);
   const float w = 1.0f / float(f * f * f);
   tbb::parallel_for(std::int64_t{0}, out.nz, [&](std::int64_t K) {
+    progress.check("downsample");
     for (std::int64_t k = K * f; k < (K + 1) * f; ++k)
       for (std::int64_t j = 0; j < out.ny * f; ++j)
         for (std::int64_t i = 0; i < out.nx * f; ++i) out.samples[out.index(i / f, j / f, K)] += im.at(i, j, k) * w;

@@ -21,7 +21,7 @@
 
 namespace levelset::apps {
 
-ImageVolume downsample_image(const ImageVolume& image, int factor);
+ImageVolume downsample_image(const ImageVolume& image, int factor, const ProgressHook& progress = {});
 std::vector<std::size_t> seed_voxels_above(const ImageVolume& image, float t, int stride, int box_radius,
                                            const ProgressHook& progress = {});
 std::vector<std::uint8_t> threshold_component(const ImageVolume& image, float t, const std::vector<std::size_t>& seeds,

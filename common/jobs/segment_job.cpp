@@ -18,36 +18,17 @@ void run_segment_job(JobContext& ctx) {
   const config::Set& s =
       ctx.section("segment", {"seeds", "seed_above", "seed_stride", "seed_radius", "sigma", "contrast", "power", "eps",
                               "attraction", "tolerance", "steps", "time", "max_time", "voxel_size", "reference_threshold"});
+  // Every option is read (and checked) before the image is read and the work starts, so a
+  // bad value fails at once.
   const std::string path = ctx.input_path(in, "image");
-  ImageVolume image = read_image(path).image;
   const int factor = ctx.integer(in, "downsample", 1, 1, 64);
-  if (factor > 1) image = apps::downsample_image(image, factor);
-  ctx.log("input: " + path + " " + std::to_string(image.nx) + "x" + std::to_string(image.ny) + "x" +
-          std::to_string(image.nz) + (factor > 1 ? " (downsampled " + std::to_string(factor) + "x)" : ""));
-
   apps::SegmentationOptions o;
-  std::vector<std::size_t> seed_voxels;
   if (ctx.has(s, "seeds") == ctx.has(s, "seed_above"))
     throw Error(ErrorCode::InvalidArgument, ctx.options().name, "the segment set needs exactly one of 'seeds' and 'seed_above'");
   o.seed_radius = ctx.number(s, "seed_radius", 0.0, 0.0, 1e30);
-  if (ctx.has(s, "seeds")) {
-    for (const Vec3d& p : ctx.points(s, "seeds")) {
-      o.seeds.push_back({p, 0.0});
-      const Vec3d q = image.to_index(p);
-      const auto clamp = [](double v, std::int64_t n) { return std::clamp<std::int64_t>(std::llround(v), 0, n - 1); };
-      seed_voxels.push_back(image.index(clamp(q.x, image.nx), clamp(q.y, image.ny), clamp(q.z, image.nz)));
-    }
-  } else {
-    const float t = static_cast<float>(ctx.number(s, "seed_above", 0.0, -1e30, 1e30));
-    seed_voxels = apps::seed_voxels_above(image, t, ctx.integer(s, "seed_stride", 6, 1, 1000), 3, ctx.options().progress);
-    if (seed_voxels.empty())
-      throw Error(ErrorCode::InvalidArgument, ctx.place(s, "seed_above"), "no voxel's 7^3 box lies above the threshold");
-    for (const std::size_t v : seed_voxels) {
-      const std::int64_t i = std::int64_t(v) % image.nx, j = (std::int64_t(v) / image.nx) % image.ny,
-                         k = std::int64_t(v) / (image.nx * image.ny);
-      o.seeds.push_back({image.world(i, j, k), o.seed_radius > 0 ? o.seed_radius : 2.5 * image.spacing.x});
-    }
-  }
+  const std::vector<Vec3d> seed_points = ctx.has(s, "seeds") ? ctx.points(s, "seeds") : std::vector<Vec3d>{};
+  const float seed_above = static_cast<float>(ctx.number(s, "seed_above", 0.0, -1e30, 1e30));
+  const int seed_stride = ctx.integer(s, "seed_stride", 6, 1, 1000);
   o.edge.sigma = ctx.number(s, "sigma", o.edge.sigma, 0.0, 100.0);
   o.edge.contrast = ctx.number(s, "contrast", o.edge.contrast, 1e-9, 1e9);
   o.edge.power = ctx.integer(s, "power", o.edge.power, 1, 2);
@@ -59,6 +40,7 @@ void run_segment_job(JobContext& ctx) {
   o.max_time = ctx.number(s, "max_time", 0.0, 0.0, 1e30);
   o.voxel_size = ctx.number(s, "voxel_size", 0.0, 0.0, 1e30);
   o.label_mask = ctx.has(s, "reference_threshold");
+  const float reference_threshold = static_cast<float>(ctx.number(s, "reference_threshold", 0.0, -1e30, 1e30));
   o.progress = ctx.options().progress;
   o.on_check = [&ctx](const apps::SegmentationCheck& c) {
     char line[160];
@@ -66,6 +48,30 @@ void run_segment_job(JobContext& ctx) {
                   c.volume, c.motion);
     ctx.log(line);
   };
+
+  ImageVolume image = read_image(path).image;
+  if (factor > 1) image = apps::downsample_image(image, factor, ctx.options().progress);
+  ctx.log("input: " + path + " " + std::to_string(image.nx) + "x" + std::to_string(image.ny) + "x" +
+          std::to_string(image.nz) + (factor > 1 ? " (downsampled " + std::to_string(factor) + "x)" : ""));
+
+  std::vector<std::size_t> seed_voxels;
+  if (!seed_points.empty()) {
+    for (const Vec3d& p : seed_points) {
+      o.seeds.push_back({p, 0.0});
+      const Vec3d q = image.to_index(p);
+      const auto clamp = [](double v, std::int64_t n) { return std::clamp<std::int64_t>(std::llround(v), 0, n - 1); };
+      seed_voxels.push_back(image.index(clamp(q.x, image.nx), clamp(q.y, image.ny), clamp(q.z, image.nz)));
+    }
+  } else {
+    seed_voxels = apps::seed_voxels_above(image, seed_above, seed_stride, 3, ctx.options().progress);
+    if (seed_voxels.empty())
+      throw Error(ErrorCode::InvalidArgument, ctx.place(s, "seed_above"), "no voxel's 7^3 box lies above the threshold");
+    for (const std::size_t v : seed_voxels) {
+      const std::int64_t i = std::int64_t(v) % image.nx, j = (std::int64_t(v) / image.nx) % image.ny,
+                         k = std::int64_t(v) / (image.nx * image.ny);
+      o.seeds.push_back({image.world(i, j, k), o.seed_radius > 0 ? o.seed_radius : 2.5 * image.spacing.x});
+    }
+  }
   const apps::SegmentationResult r = apps::segment_image(image, o);
   ctx.log("segmentation: " + std::to_string(r.steps) + " steps, " + (r.converged ? "steady" : "not steady"));
   ctx.stats()["segment"] = {{"seeds", o.seeds.size()},
@@ -77,8 +83,8 @@ void run_segment_job(JobContext& ctx) {
                             {"spacing", {image.spacing.x, image.spacing.y, image.spacing.z}},
                             {"seconds", {{"edges", r.seconds_edges}, {"evolve", r.seconds_evolve}, {"total", r.seconds_total}}}};
   if (o.label_mask) {
-    const float t = static_cast<float>(ctx.number(s, "reference_threshold", 0.0, -1e30, 1e30));
-    const std::vector<std::uint8_t> reference = apps::threshold_component(image, t, seed_voxels, ctx.options().progress);
+    const std::vector<std::uint8_t> reference =
+        apps::threshold_component(image, reference_threshold, seed_voxels, ctx.options().progress);
     const double d = apps::dice(reference, r.label_mask);
     ctx.stats()["segment"]["dice_vs_threshold"] = d;
     ctx.log("Dice against the threshold component: " + std::to_string(d));
