@@ -209,8 +209,7 @@ CsgResult csg(const NarrowBand& a, const NarrowBand& b, const CsgOptions& option
     eo.redistance_every = options.seam_redistance_every;
     eo.progress = options.progress;
     evolve::EvolutionResult er = evolve::evolve(result.band, eo);
-    if (er.stop == evolve::StopReason::Cancelled) throw Error(ErrorCode::Cancelled, "csg", "cancelled");
-    if (er.stop == evolve::StopReason::NonFinite) throw Error(ErrorCode::NonFinite, "csg seam fairing", er.message);
+    evolve::throw_if_stopped(er, "csg seam fairing");
     result.band = std::move(er.band);
     result.seam_steps = er.steps;
     result.seam_time = er.time;

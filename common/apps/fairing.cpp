@@ -49,8 +49,7 @@ FairingResult fair_surface(const NarrowBand& band, const FairingOptions& options
   eo.redistance_every = options.redistance_every;
   eo.progress = options.progress;
   evolve::EvolutionResult er = evolve::evolve(band, eo);
-  if (er.stop == evolve::StopReason::Cancelled) throw Error(ErrorCode::Cancelled, "fairing", "cancelled");
-  if (er.stop == evolve::StopReason::NonFinite) throw Error(ErrorCode::NonFinite, "fairing", er.message);
+  evolve::throw_if_stopped(er, "fairing");
   result.band = std::move(er.band);
   result.steps = er.steps;
   result.time = er.time;

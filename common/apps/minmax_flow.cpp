@@ -147,8 +147,7 @@ MinMaxResult minmax_flow(const NarrowBand& band, const MinMaxOptions& o) {
     eo.steps = std::min(o.update_every, o.max_steps - steps);
     eo.progress = o.progress;
     evolve::EvolutionResult er = evolve::evolve(current, eo);
-    if (er.stop == evolve::StopReason::Cancelled) throw Error(ErrorCode::Cancelled, "minmax", "cancelled");
-    if (er.stop == evolve::StopReason::NonFinite) throw Error(ErrorCode::NonFinite, "minmax", er.message);
+    evolve::throw_if_stopped(er, "minmax");
     const Change change = change_near_front(current, er.band);
     steps += er.steps;
     time += er.time;

@@ -26,8 +26,7 @@ OffsetResult offset_surface(const NarrowBand& band, const OffsetOptions& options
   eo.drift_tolerance = options.drift_tolerance;
   eo.progress = options.progress;
   evolve::EvolutionResult er = evolve::evolve(band, eo);
-  if (er.stop == evolve::StopReason::Cancelled) throw Error(ErrorCode::Cancelled, "offset", "cancelled");
-  if (er.stop == evolve::StopReason::NonFinite) throw Error(ErrorCode::NonFinite, "offset", er.message);
+  evolve::throw_if_stopped(er, "offset");
   OffsetResult result;
   result.steps = er.steps;
   result.time = er.time;

@@ -712,16 +712,14 @@ ReconstructionResult reconstruct_surface(const std::vector<Vec3d>& input, const 
           return stage.last_change < o.tolerance;
         };
         evolve::EvolutionResult r = evolve::evolve(band, ev);
-        if (r.stop == evolve::StopReason::Cancelled) throw Error(ErrorCode::Cancelled, "reconstruct", "operation cancelled");
-        if (r.stop == evolve::StopReason::NonFinite) throw Error(ErrorCode::NonFinite, "reconstruct", r.message);
+        evolve::throw_if_stopped(r, "reconstruct");
         stage.steps = r.steps;
         stage.seconds_redistance = r.seconds.redistance;
         band = std::move(r.band);
       }
       for (int step = 1; o.guard_flow && step <= o.max_steps; ++step) {
         evolve::EvolutionResult r = evolve::evolve(band, ev);
-        if (r.stop == evolve::StopReason::Cancelled) throw Error(ErrorCode::Cancelled, "reconstruct", "operation cancelled");
-        if (r.stop == evolve::StopReason::NonFinite) throw Error(ErrorCode::NonFinite, "reconstruct", r.message);
+        evolve::throw_if_stopped(r, "reconstruct");
         stage.seconds_redistance += r.seconds.redistance;
         TopologyGuardOptions guard;
         guard.eps = 1e-3 * h;

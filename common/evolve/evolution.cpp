@@ -805,6 +805,11 @@ EvolutionResult evolve(const NarrowBand& band, const EvolutionOptions& options) 
   return result;
 }
 
+void throw_if_stopped(const EvolutionResult& result, const std::string& where) {
+  if (result.stop == StopReason::Cancelled) throw Error(ErrorCode::Cancelled, where, "operation cancelled");
+  if (result.stop == StopReason::NonFinite) throw Error(ErrorCode::NonFinite, where, result.message);
+}
+
 std::string_view to_string(StopReason reason) {
   switch (reason) {
     case StopReason::Completed: return "completed";

@@ -139,4 +139,8 @@ EvolutionResult evolve(const NarrowBand& band, const EvolutionOptions& options);
 // "completed", "cancelled", "non-finite".
 std::string_view to_string(StopReason reason);
 
+// For callers that treat an interrupted run as a failure: throws Error{Cancelled} or
+// Error{NonFinite} (with the run's message) at `where` when the run stopped so.
+void throw_if_stopped(const EvolutionResult& result, const std::string& where);
+
 }  // namespace levelset::evolve
