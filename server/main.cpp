@@ -11,6 +11,7 @@
 #include "commands/command.hpp"
 #include "commands/commands.hpp"
 #include "core/error.hpp"
+#include "core/text.hpp"
 #include "evolve/speed.hpp"
 #include "geometry/analytic_shapes.hpp"
 
@@ -117,7 +118,12 @@ int main(int argc, char** argv) {
       ->check(CLI::NonNegativeNumber);
   evolve_cmd->add_option("--drift-tolerance", evolve.drift_tolerance,
                          "Redistance when the mean ||grad u| - 1| near the surface exceeds this (0: off)")
-      ->check(CLI::NonNegativeNumber);
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
+  evolve_cmd->add_option("--band-growth-limit", evolve.band_growth_limit,
+                         "Redistance when the band holds more than this many times a fresh band's voxels (0: off, else >= 1)")
+      ->check(CLI::Range(0.0, 1e6))
+      ->capture_default_str();
   evolve_cmd->add_flag("--extension", evolve.extension, "Extension velocities (speed constant along normals)");
   evolve_cmd->add_option("--report-every", evolve.report_every, "Print a progress line every N steps")
       ->check(CLI::NonNegativeNumber);
@@ -129,7 +135,7 @@ int main(int argc, char** argv) {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
     if (e.get_exit_code() == 0) return app.exit(e);  // --help, --version
-    std::fprintf(stderr, "levelsetd: usage: %s (see levelsetd --help)\n", e.what());
+    std::fprintf(stderr, "levelsetd: usage: %s (see levelsetd --help)\n", levelset::sanitize_utf8(e.what()).c_str());
     return 2;
   }
 
@@ -164,7 +170,7 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "levelsetd: out of memory\n");
     return 1;
   } catch (const std::exception& e) {  // not ours (a library's): still one line and exit 1
-    std::fprintf(stderr, "levelsetd: internal error: %s\n", e.what());
+    std::fprintf(stderr, "levelsetd: internal error: %s\n", levelset::sanitize_utf8(e.what()).c_str());
     return 1;
   }
   return 2;

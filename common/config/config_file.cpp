@@ -7,6 +7,7 @@
 #include <unordered_set>
 
 #include "core/error.hpp"
+#include "core/text.hpp"
 #include "core/file_io.hpp"
 #include "core/suggest.hpp"
 
@@ -52,7 +53,7 @@ class Parser {
                   std::to_string(text_.size()) + " bytes, more than " + std::to_string(options_.limits.max_bytes));
     Set root = parse_set(0);
     skip_blank();
-    if (pos_ < text_.size()) fail("unexpected '" + std::string(1, text_[pos_]) + "' (a '}' without its set?)");
+    if (pos_ < text_.size()) fail("unexpected " + quote_character(text_, pos_).text + " (a '}' without its set?)");
     return root;
   }
 
@@ -159,7 +160,7 @@ class Parser {
   void end_of_value() {
     skip_spaces();
     if (pos_ < text_.size() && text_[pos_] != '\n' && text_[pos_] != '}' && !starts_comment())
-      fail("unexpected '" + std::string(1, text_[pos_]) + "' after the value");
+      fail("unexpected " + quote_character(text_, pos_).text + " after the value");
   }
 
   Set parse_set(int depth) {
@@ -174,7 +175,7 @@ class Parser {
       advance_place(pos_);
       e.line = place_line_;
       e.column = place_column_;
-      if (!is_key_start(text_[pos_])) fail("expected a key (a name such as 'depth'), found '" + std::string(1, text_[pos_]) + "'");
+      if (!is_key_start(text_[pos_])) fail("expected a key (a name such as 'depth'), found " + quote_character(text_, pos_).text);
       const std::size_t key_start = pos_;
       while (pos_ < text_.size() && is_key_char(text_[pos_])) ++pos_;
       e.key = std::string(text_.substr(key_start, pos_ - key_start));

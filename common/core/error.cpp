@@ -1,5 +1,7 @@
 #include "core/error.hpp"
 
+#include "core/text.hpp"
+
 namespace levelset {
 
 std::string_view to_string(ErrorCode code) {
@@ -27,11 +29,13 @@ std::string compose(ErrorCode code, const std::string& where, const std::string&
 }
 }  // namespace
 
+// Places and reasons often quote untrusted bytes (file names, formulas, job files): both are
+// kept valid UTF-8 (stray bytes as \xNN) so every message can go into JSON as it is.
 Error::Error(ErrorCode code, std::string where, std::string reason)
-    : std::runtime_error(compose(code, where, reason)),
+    : std::runtime_error(compose(code, sanitize_utf8(where), sanitize_utf8(reason))),
       code_(code),
-      where_(std::move(where)),
-      reason_(std::move(reason)) {}
+      where_(sanitize_utf8(where)),
+      reason_(sanitize_utf8(reason)) {}
 
 std::string at_line(std::string_view file, std::uint64_t line) {
   return std::string(file) + ":" + std::to_string(line);

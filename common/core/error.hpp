@@ -2,7 +2,8 @@
 //
 // Every failure carries a code (what kind), a place (file + line, byte offset, column,
 // or a name) and a reason (why), so the CLI and later the server can answer with a
-// clear, structured message instead of crashing. Readers of untrusted input throw it
+// clear, structured message instead of crashing. Place and reason are always valid UTF-8
+// (bytes that are not become \xNN; core/text.hpp). Readers of untrusted input throw it
 // for every malformed case; algorithms throw it for invalid options and cancellation.
 #pragma once
 

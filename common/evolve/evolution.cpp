@@ -16,6 +16,7 @@
 #include <tbb/parallel_for.h>
 
 #include "core/error.hpp"
+#include "core/text.hpp"
 #include "distance/redistance.hpp"
 #include "evolve/band_tracking.hpp"
 #include "evolve/curvature.hpp"
@@ -45,7 +46,7 @@ struct Scratch {
   std::array<std::array<OneSided, 3>, kBrickVoxels> os;
   std::unique_ptr<struct AxisLines> lines;
   std::array<Vec3d, kBrickVoxels> vel;
-  std::array<int, kBrickVoxels> tile_at;
+  std::array<int, kBrickVoxels> curvature_at_tile;  // tile index whose curvature a voxel takes; -1: none
 };
 
 bool active_at(const Scratch& s, int x, int y, int z) {
@@ -65,6 +66,50 @@ struct EdgeStencil {
   std::uint8_t neighbors = 0;
   std::array<std::uint32_t, 6> neighbor{};
 };
+
+// Whether the 19-point curvature stencil around tile position p (centre, faces, edges) is
+// all active: inactive samples hold +-W h, not the field, and a curvature read through them is
+// wrong by up to 1 / (2 h).
+bool curvature_stencil_active(const Scratch& s, const Coord& p) {
+  auto row = [&](int y, int z) { return s.rows[std::size_t((y - kLo) + kDim * (z - kLo))] >> (p.x - 1 - kLo); };
+  constexpr std::uint32_t three = 7u, middle = 2u;
+  if ((row(p.y, p.z) & three) != three) return false;
+  for (int d = -1; d <= 1; d += 2) {
+    if ((row(p.y + d, p.z) & three) != three || (row(p.y, p.z + d) & three) != three) return false;
+    if (!(row(p.y + d, p.z - 1) & middle) || !(row(p.y + d, p.z + 1) & middle)) return false;
+  }
+  return true;
+}
+
+// Where a voxel takes its curvature from (a tile index), or -1. Near the band's edge the
+// stencil reads inactive samples; there the voxel takes the curvature of the first voxel
+// with a whole stencil on the way toward the front (stepping to the active 6-neighbour of
+// smallest |u|, at most 3 steps). Level sets of a distance function are parallel, so that
+// is the curvature of a neighbouring level set, off by O(h k^2); a garbage curvature here
+// fed the parabolic part with rates of 1 / h and made the band drift and grow (issue 13).
+// -1 (no curvature) where no such voxel is near (a band too thin for the stencil).
+int curvature_source(const Scratch& s, const Coord& l) {
+  Coord p = l;
+  for (int hop = 0;; ++hop) {
+    if (curvature_stencil_active(s, p)) return tile_index(p.x, p.y, p.z);
+    if (hop == 3) return -1;
+    const float here = std::abs(s.tile[std::size_t(tile_index(p.x, p.y, p.z))]);
+    Coord best = p;
+    float best_value = here;
+    for (int f = 0; f < 6; ++f) {
+      Coord q = p;
+      q[f >> 1] += (f & 1) ? 1 : -1;
+      if (q[f >> 1] <= kLo || q[f >> 1] >= kHi - 1 || !active_at(s, q.x, q.y, q.z)) continue;
+      const float v = std::abs(s.tile[std::size_t(tile_index(q.x, q.y, q.z))]);
+      if (v < best_value) {
+        best_value = v;
+        best = q;
+      }
+    }
+    if (best == p) return -1;
+    p = best;
+  }
+}
 
 bool is_edge(const Scratch& s, const Coord& l) {
   for (int a = 0; a < 3; ++a)
@@ -223,6 +268,18 @@ struct OperatorOutput {
   std::vector<std::vector<EdgeStencil>> edge_stencils;  // per brick
   double max_hyperbolic = 0, max_speed = 0, max_front_speed = 0, drift_sum = 0;
   std::uint64_t drift_count = 0;
+  // Grid edges between 6-neighbours of opposite sign (want_edges only): a measure of the zero
+  // level's area, about A / h^2 times |n|_1, that does not depend on |grad u|.
+  std::uint64_t crossings = 0;
+  float min_value = 0, max_value = 0;  // over the active voxels (want_edges only)
+  OperatorSeconds seconds;
+};
+
+// One thread's share of the operator's reductions.
+struct OperatorStats {
+  double max_hyp = 0, max_speed = 0, max_front = 0, drift_sum = 0;
+  std::uint64_t drift_count = 0, crossings = 0;
+  float min_value = std::numeric_limits<float>::infinity(), max_value = -std::numeric_limits<float>::infinity();
   OperatorSeconds seconds;
 };
 
@@ -231,8 +288,8 @@ bool has_speed(const EvolutionOptions& o) { return bool(o.speed.eval); }
 
 // The spatial operator on one brick: rates (and betas, edges) for its active voxels.
 void brick_operator(const NarrowBand& band, std::uint32_t b, const OperatorSetup& setup, Scratch& s,
-                    OperatorOutput& out, double& max_hyp, double& max_speed, double& max_front, double& drift_sum,
-                    std::uint64_t& drift_count, OperatorSeconds& out_seconds) {
+                    OperatorOutput& out, OperatorStats& stats) {
+  OperatorSeconds& out_seconds = stats.seconds;
   const auto t_start = Clock::now();
   const EvolutionOptions& o = setup.options;
   const SpeedFunction& speed = o.speed;
@@ -306,7 +363,7 @@ void brick_operator(const NarrowBand& band, std::uint32_t b, const OperatorSetup
       g = Vec3d{double(v[1]) - double(v[-1]), double(v[kDim]) - double(v[-kDim]),
                 double(v[kDim * kDim]) - double(v[-kDim * kDim])} * (0.5 / h);
     const double gn = want_grad ? length(g) : 0.0;
-    s.tile_at[std::size_t(k)] = tile_index(l.x, l.y, l.z);
+    if (needs & (kNeedsMean | kNeedsPrincipal)) s.curvature_at_tile[std::size_t(k)] = curvature_source(s, l);
     s.grad[std::size_t(k)] = float(gn);
     if (needs & kNeedsNormal) {
       const Vec3d nrm = gn > 0 ? g / gn : Vec3d{};
@@ -318,9 +375,14 @@ void brick_operator(const NarrowBand& band, std::uint32_t b, const OperatorSetup
                                      double(s.dgz[std::size_t(k)]) * nrm.z);
     }
     if (near) {
-      drift_sum += std::abs(gn - 1.0);
-      ++drift_count;
+      stats.drift_sum += std::abs(gn - 1.0);
+      ++stats.drift_count;
     }
+    stats.min_value = std::min(stats.min_value, *v);
+    stats.max_value = std::max(stats.max_value, *v);
+    if (setup.want_edges)
+      stats.crossings += unsigned((v[0] < 0.0f) != (v[1] < 0.0f)) + unsigned((v[0] < 0.0f) != (v[kDim] < 0.0f)) +
+                         unsigned((v[0] < 0.0f) != (v[kDim * kDim] < 0.0f));
     if (setup.want_edges && is_edge(s, l)) {
       out.edge[first + std::size_t(k)] = 1;
       EdgeStencil e = edge_stencil(band, around, s, l);
@@ -336,15 +398,18 @@ void brick_operator(const NarrowBand& band, std::uint32_t b, const OperatorSetup
   out_seconds.gradient += std::chrono::duration<double>(t_curvature - t_start).count();
   if (needs & kNeedsPrincipal) {
     for (int i = 0; i < count; ++i) {
-      const Curvature c = curvature_at(s.tile.data() + s.tile_at[std::size_t(i)], kStride, h);
+      const int at = s.curvature_at_tile[std::size_t(i)];
+      const Curvature c = at >= 0 ? curvature_at(s.tile.data() + at, kStride, h) : Curvature{};
       s.mean[std::size_t(i)] = float(c.mean);
       s.gauss[std::size_t(i)] = float(c.gauss);
       s.k1[std::size_t(i)] = float(c.k1);
       s.k2[std::size_t(i)] = float(c.k2);
     }
   } else if (needs & kNeedsMean) {
-    for (int i = 0; i < count; ++i)
-      s.mean[std::size_t(i)] = float(mean_curvature_at(s.tile.data() + s.tile_at[std::size_t(i)], kStride, h));
+    for (int i = 0; i < count; ++i) {
+      const int at = s.curvature_at_tile[std::size_t(i)];
+      s.mean[std::size_t(i)] = at >= 0 ? float(mean_curvature_at(s.tile.data() + at, kStride, h)) : 0.0f;
+    }
   }
   const auto t_speed = Clock::now();
   out_seconds.curvature += std::chrono::duration<double>(t_speed - t_curvature).count();
@@ -419,12 +484,12 @@ void brick_operator(const NarrowBand& band, std::uint32_t b, const OperatorSetup
     if (parabolic) rate -= bp * double(s.grad[u]);
     out.rate[first + u] = float(rate);
     const double vsum = std::abs(vel.x) + std::abs(vel.y) + std::abs(vel.z);
-    max_hyp = std::max(max_hyp, kSqrt3 * std::abs(ba) + vsum);
+    stats.max_hyp = std::max(stats.max_hyp, kSqrt3 * std::abs(ba) + vsum);
     const double sp = std::abs(ba) + std::abs(bp) + length(vel);
-    max_speed = std::max(max_speed, sp);
+    stats.max_speed = std::max(stats.max_speed, sp);
     // The front's speed: voxels next to the zero level only (curvatures blow up near the
     // skeleton, deep in the band, without the front moving).
-    if (std::abs(s.d[u]) < 1.5 * h) max_front = std::max(max_front, sp);
+    if (std::abs(s.d[u]) < 1.5 * h) stats.max_front = std::max(stats.max_front, sp);
   }
   out_seconds.rates += since(t_rates);
 }
@@ -468,6 +533,8 @@ double mean_curvature_average(const NarrowBand& band) {
 
 OperatorOutput run_operator(const NarrowBand& band, const OperatorSetup& setup) {
   OperatorOutput out;
+  out.min_value = std::numeric_limits<float>::infinity();
+  out.max_value = -std::numeric_limits<float>::infinity();
   const std::size_t n = band.active_voxel_count();
   out.rate.assign(n, 0.0f);
   if (setup.want_betas) {
@@ -478,22 +545,16 @@ OperatorOutput run_operator(const NarrowBand& band, const OperatorSetup& setup) 
     out.edge.assign(n, 0);
     out.edge_stencils.resize(band.brick_count());
   }
-  struct Stats {
-    double max_hyp = 0, max_speed = 0, max_front = 0, drift_sum = 0;
-    std::uint64_t drift_count = 0;
-    OperatorSeconds seconds;
-  };
-  tbb::combinable<Stats> stats;
+  tbb::combinable<OperatorStats> stats;
   tbb::enumerable_thread_specific<Scratch> scratch;
   tbb::parallel_for(tbb::blocked_range<std::uint32_t>(0, std::uint32_t(band.brick_count()), 8),
                     [&](const tbb::blocked_range<std::uint32_t>& r) {
     Scratch& s = scratch.local();
-    Stats& st = stats.local();
+    OperatorStats& st = stats.local();
     for (std::uint32_t b = r.begin(); b != r.end(); ++b)
-      brick_operator(band, b, setup, s, out, st.max_hyp, st.max_speed, st.max_front, st.drift_sum, st.drift_count,
-                     st.seconds);
+      brick_operator(band, b, setup, s, out, st);
   });
-  stats.combine_each([&](const Stats& st) {
+  stats.combine_each([&](const OperatorStats& st) {
     out.max_hyperbolic = std::max(out.max_hyperbolic, st.max_hyp);
     out.max_speed = std::max(out.max_speed, st.max_speed);
     out.max_front_speed = std::max(out.max_front_speed, st.max_front);
@@ -503,6 +564,9 @@ OperatorOutput run_operator(const NarrowBand& band, const OperatorSetup& setup) 
     out.seconds.rates += st.seconds.rates;
     out.drift_sum += st.drift_sum;
     out.drift_count += st.drift_count;
+    out.crossings += st.crossings;
+    out.min_value = std::min(out.min_value, st.min_value);
+    out.max_value = std::max(out.max_value, st.max_value);
   });
   return out;
 }
@@ -569,6 +633,8 @@ void check_options(const NarrowBand& band, const EvolutionOptions& o) {
     missing(kNeedsRoi, bool(f.roi), "roi");
   }
   if (!(o.track_distance > 0 && o.track_distance <= 1)) bad("track_distance must be in (0, 1] voxels");
+  if (!(o.band_growth_limit == 0 || (o.band_growth_limit >= 1 && o.band_growth_limit <= 1e6)))
+    bad("band_growth_limit must be 0 (off) or in [1, 1e6]");
 }
 
 // f(i) for i in [0, n), in parallel (the RK combinations and checks over all values).
@@ -615,6 +681,10 @@ EvolutionResult evolve(const NarrowBand& band, const EvolutionOptions& options) 
   NarrowBand& cur = result.band;
   double t = 0, motion = 0;
   int steps_since_redistance = 0;
+  // Band growth guard: active voxels per crossing of a fresh band (measured at the first step
+  // and after each redistance, within what a fresh band can hold: 2W / sqrt(3) for a plane
+  // along a cube diagonal to 2W + 1 along an axis); 0: measure at the next step.
+  double fresh_ratio = 0;
   auto add_phases = [&](const OperatorOutput& op) {
     result.seconds.gradient_cpu += op.seconds.gradient;
     result.seconds.curvature_cpu += op.seconds.curvature;
@@ -649,6 +719,25 @@ EvolutionResult evolve(const NarrowBand& band, const EvolutionOptions& options) 
       op.edge = std::move(edge);
     }
     result.seconds.operator_eval += since(t0);
+    // No sign change left in the band, or none with any volume on one side (the inside, or
+    // the outside, only touches the zero level: a sphere redistanced at the moment it shrinks
+    // to a point holds one voxel at -1e-37 among neighbours at h, and its exactly symmetric
+    // stencil has no gradient to move it): the surface vanished (or was never there).
+    const float flat = float(1e-3 * h);
+    if (op.crossings == 0 || op.min_value > -flat || op.max_value < flat) {
+      // Nothing can move any more; the band is emptied with the remaining sign everywhere.
+      result.stop = StopReason::Vanished;
+      result.message = "the surface vanished after " + std::to_string(result.steps) + " steps (t = " +
+                       format_number(t) + ")";
+      const bool inside = cur.active_voxel_count() > 0 ? op.max_value < flat : cur.far_inside();
+      cur = NarrowBand(cur.frame());
+      cur.set_far_inside(inside);
+      motion = 0;
+      break;
+    }
+    if (fresh_ratio == 0)
+      fresh_ratio = std::clamp(double(cur.active_voxel_count()) / double(op.crossings), 2.0 * half_width / kSqrt3,
+                               2.0 * half_width + 1.0);
     const double grad_drift = op.drift_count ? op.drift_sum / double(op.drift_count) : 0.0;
     const double rate_limit = op.max_hyperbolic / h + 6.0 * diffusion / (h * h);
     double dt = rate_limit > 0 ? cfl / rate_limit : cfl * h;
@@ -753,9 +842,15 @@ EvolutionResult evolve(const NarrowBand& band, const EvolutionOptions& options) 
     }
     result.seconds.tracking += since(t3);
     ++steps_since_redistance;
-    const bool due = mine || (options.redistance_every > 0 && steps_since_redistance >= options.redistance_every) ||
+    const bool overgrown = options.band_growth_limit > 0 &&
+                           double(tracked.band.active_voxel_count()) >
+                               options.band_growth_limit * fresh_ratio * double(op.crossings);
+    const bool due = mine || overgrown ||
+                     (options.redistance_every > 0 && steps_since_redistance >= options.redistance_every) ||
                      (options.drift_tolerance > 0 && grad_drift > options.drift_tolerance);
     if (due) {
+      result.growth_redistance_count += overgrown;
+      fresh_ratio = 0;
       auto t4 = Clock::now();
       RedistanceOptions ro;
       ro.half_width = half_width;
@@ -779,6 +874,8 @@ EvolutionResult evolve(const NarrowBand& band, const EvolutionOptions& options) 
     info.landmine_count = result.landmine_count;
     info.grad_drift = grad_drift;
     info.elapsed_seconds = since(start);
+    info.crossings = op.crossings;
+    info.band = &cur;
     if (options.on_step) options.on_step(info);
     if (options.progress.on_progress) {
       const double f = options.steps > 0 ? double(step) / options.steps : t / options.time;
@@ -815,6 +912,7 @@ std::string_view to_string(StopReason reason) {
     case StopReason::Completed: return "completed";
     case StopReason::Cancelled: return "cancelled";
     case StopReason::NonFinite: return "non-finite";
+    case StopReason::Vanished: return "vanished";
   }
   return "?";
 }

@@ -31,8 +31,14 @@
 //      front may have moved track_distance voxels since the last one (sum of
 //      dt * max |speed|), and after a land mine.
 //   5. Redistance (distance/redistance.hpp, fast sweeping, zero level kept) every
-//      redistance_every steps and whenever the mean ||grad u| - 1| over the voxels within
-//      2 h of the zero level exceeds drift_tolerance.
+//      redistance_every steps, whenever the mean ||grad u| - 1| over the voxels within
+//      2 h of the zero level exceeds drift_tolerance (on by default: 0.05), and whenever
+//      the band holds more than band_growth_limit (default 1.5) times the voxels a fresh
+//      band of the same surface would (active voxels per zero crossing, measured after each
+//      redistance). With the defaults the band stays bounded for any number of steps.
+//   Curvatures near the band's edge, where the 19-point stencil would read inactive
+//   samples, are taken from the nearest voxel toward the front with a whole stencil (the
+//   curvature of a parallel level set); see curvature_source in evolution.cpp.
 //   Extension velocities (thesis 2.3.5, options.extension): the speeds are first computed
 //   on the band, then every voxel takes the (trilinearly interpolated) speeds at its
 //   closest point x - u n on the zero level, so the speed is constant along normals and the
@@ -40,15 +46,18 @@
 // Output: EvolutionResult; the band after the last completed step (never a partial step).
 // Stopping: steps reached, time reached, max_steps, stop_when returning true after a step
 //   (stop = Completed, message says so; for convergence tests), the cancel token (checked
-//   between steps: stop = Cancelled), or a NaN/Inf entering the band (stop = NonFinite with a message naming
-//   the step and voxel; the band is the last good state). Nothing is thrown for these.
+//   between steps: stop = Cancelled), a NaN/Inf entering the band (stop = NonFinite with a message naming
+//   the step and voxel; the band is the last good state), or no zero crossing left in the band
+//   (stop = Vanished: the surface shrank away; the band is returned empty with the remaining
+//   sign). Nothing is thrown for these.
 // Units: world units and time; StepInfo.dt in time units.
 // Cost per step: O(active voxels) per RK stage (x3 for RK3) plus the band upkeep O(active
 //   voxels + bricks log bricks); curvatures add a 27-point stencil and, for K/k1/k2, a 2x2
 //   eigen-solve per voxel. Memory: about 3 value arrays besides the band.
 // Threading: TBB over bricks; results are identical for any thread count.
 // Errors (thrown): Error{InvalidArgument} for bad options (no motion given, both or neither
-//   of steps/time, cfl not in (0, 1], rk_order not 1 or 3, W < 2, negative counts).
+//   of steps/time, cfl not in (0, 1], rk_order not 1 or 3, W < 2, negative counts,
+//   band_growth_limit not 0 or in [1, 1e6]).
 #pragma once
 
 #include <cstdint>
@@ -80,8 +89,20 @@ struct StepInfo {
   int redistance_count = 0;
   int landmine_count = 0;
   double grad_drift = 0;        // mean ||grad u| - 1| within 2 h of the zero level (before upkeep)
+  std::uint64_t crossings = 0;  // grid edges across the zero level at the step's start (area / h^2 times |n|_1)
   double elapsed_seconds = 0;
+  // The band after this step, valid during the callback only (viewers, tests).
+  const NarrowBand* band = nullptr;
 };
+
+// Default drift tolerance: redistance once the mean ||grad u| - 1| near the front passes it.
+// Measured on mean-curvature flow of a sphere to half its radius (R = 64 and 128): 0.02-0.1
+// all keep the radius within 0.5 % of sqrt(r0^2 - 4t); without it the flow's own stretching
+// of the level sets (|grad u| -> r / r0) went unchecked.
+inline constexpr double kDefaultDriftTolerance = 0.05;
+// Default band growth guard: redistance when the band holds more than this many times the
+// voxels of a fresh band around the same surface.
+inline constexpr double kDefaultBandGrowthLimit = 1.5;
 
 struct EvolutionOptions {
   SpeedFunction speed;          // no eval: no normal motion
@@ -95,7 +116,10 @@ struct EvolutionOptions {
   double time = 0;              // ... until this time (exactly one of the two > 0)
   int max_steps = 1000000;      // cap for time-driven runs
   int redistance_every = 0;     // 0: not by count
-  double drift_tolerance = 0;   // 0: not by drift
+  double drift_tolerance = kDefaultDriftTolerance;  // 0: not by drift
+  // Redistance when the active voxels exceed this many times a fresh band's count for the
+  // current surface (estimated from the zero crossings, see StepInfo::crossings); 0: off.
+  double band_growth_limit = kDefaultBandGrowthLimit;
   bool extension = false;
   double track_distance = 0.5;  // voxels the front may move between band upkeeps, in (0, 1]
   std::function<void(const StepInfo&)> on_step;  // after every step, from the calling thread
@@ -105,7 +129,9 @@ struct EvolutionOptions {
   ProgressHook progress;        // fraction of steps / time; cancel checked between steps
 };
 
-enum class StopReason { Completed, Cancelled, NonFinite };
+// Vanished: no sign change is left in the band (the surface shrank to nothing, or the input
+// had none); the band is then emptied, its sign everywhere the one that remained.
+enum class StopReason { Completed, Cancelled, NonFinite, Vanished };
 
 struct EvolutionSeconds {
   double operator_eval = 0;     // derivatives, curvature, speed, per-voxel rates (all stages)
@@ -125,6 +151,7 @@ struct EvolutionResult {
   int steps = 0;
   double time = 0;
   int redistance_count = 0;
+  int growth_redistance_count = 0;  // of those, by the band growth guard
   int landmine_count = 0;
   std::uint64_t activated = 0, retired = 0;  // by the band upkeep, all steps
   int band_updates = 0;         // band upkeeps run

@@ -8,6 +8,7 @@
 #include <string>
 
 #include "core/error.hpp"
+#include "core/text.hpp"
 #include "core/suggest.hpp"
 
 namespace levelset::formula {
@@ -138,7 +139,7 @@ class Parser {
   void advance() {
     while (pos_ < text_.size() && std::isspace(static_cast<unsigned char>(text_[pos_]))) ++pos_;
     tok_ = Token{};
-    tok_.column = int(pos_) + 1;
+    tok_.column = int(utf8_column(text_, pos_));
     if (pos_ >= text_.size()) return;
     const char c = text_[pos_];
     if (std::isdigit(static_cast<unsigned char>(c)) || (c == '.' && pos_ + 1 < text_.size() &&
@@ -184,7 +185,14 @@ class Parser {
       ++pos_;
       return;
     }
-    fail(text_, tok_.column, std::string("unexpected character '") + c + "'");
+    const QuotedCharacter q = quote_character(text_, pos_);
+    // Typographic look-alikes (pasted from documents) get the ASCII operator named.
+    static constexpr std::pair<std::string_view, const char*> kLookAlikes[] = {
+        {"\u2212", "-"}, {"\u2013", "-"}, {"\u00D7", "*"}, {"\u22C5", "*"}, {"\u00B7", "*"}, {"\u00F7", "/"}};
+    std::string hint;
+    for (const auto& [glyph, ascii] : kLookAlikes)
+      if (text_.substr(pos_, glyph.size()) == glyph) hint = std::string(" (write '") + ascii + "')";
+    fail(text_, tok_.column, "unexpected character " + q.text + hint);
   }
 
   bool is(const char* sym) const { return tok_.kind == Token::Sym && tok_.text == sym; }

@@ -2,7 +2,10 @@
 // thesis's PDE set) for a number of steps or a time. Its set:
 //   evolve { speed = -sign(H)*sqrt(K+abs(K))   c = 1  eps = 0.1   constants { a = 2 }
 //            steps = 20 | time = 0.5   scheme = godunov|eno2|weno5   rk = 1|3   cfl = 0.5
-//            redistance_every = 0   drift_tolerance = 0   extension = no   report_every = 10 }
+//            redistance_every = 0   drift_tolerance = 0.05   band_growth_limit = 1.5
+//            extension = no   report_every = 10 }
+// drift_tolerance and band_growth_limit keep long runs bounded (evolve/evolution.hpp); 0 turns
+// either off.
 #include <algorithm>
 #include <cstdio>
 #include <map>
@@ -38,7 +41,10 @@ evolve::EvolutionOptions evolution_options_from(JobContext& ctx, const config::S
   if (o.rk_order == 2) throw Error(ErrorCode::InvalidArgument, ctx.place(s, "rk"), "rk must be 1 or 3");
   o.cfl = ctx.number(s, "cfl", 0.0, 0.0, 1.0);
   o.redistance_every = ctx.integer(s, "redistance_every", 0, 0, 1000000);
-  o.drift_tolerance = ctx.number(s, "drift_tolerance", 0.0, 0.0, 10.0);
+  o.drift_tolerance = ctx.number(s, "drift_tolerance", evolve::kDefaultDriftTolerance, 0.0, 10.0);
+  o.band_growth_limit = ctx.number(s, "band_growth_limit", evolve::kDefaultBandGrowthLimit, 0.0, 1e6);
+  if (o.band_growth_limit > 0 && o.band_growth_limit < 1)
+    throw Error(ErrorCode::InvalidArgument, ctx.place(s, "band_growth_limit"), "must be 0 (off) or at least 1");
   o.extension = ctx.flag(s, "extension", false);
   o.progress = ctx.options().progress;
   const int every = ctx.integer(s, "report_every", 10, 0, 1000000);
@@ -59,6 +65,7 @@ nlohmann::json evolution_json(const evolve::EvolutionResult& r) {
           {"time", r.time},
           {"stop", std::string(evolve::to_string(r.stop))},
           {"redistance_count", r.redistance_count},
+          {"growth_redistance_count", r.growth_redistance_count},
           {"landmine_count", r.landmine_count},
           {"band_updates", r.band_updates},
           {"grad_drift", r.grad_drift},
@@ -68,7 +75,8 @@ nlohmann::json evolution_json(const evolve::EvolutionResult& r) {
 void run_evolve_job(JobContext& ctx) {
   const config::Set& input = ctx.section("input", JobContext::input_keys());
   const config::Set& s = ctx.section("evolve", {"speed", "c", "eps", "constants", "steps", "time", "scheme", "rk", "cfl",
-                                                "redistance_every", "drift_tolerance", "extension", "report_every"});
+                                                "redistance_every", "drift_tolerance", "band_growth_limit", "extension",
+                                                "report_every"});
   const NarrowBand band = ctx.input_band(input);
   const MeshMeasures before = ctx.measure_band(band);
   ctx.stats()["mesh_before"] = measures_json(before);

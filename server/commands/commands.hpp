@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "evolve/evolution.hpp"
 #include "grid/narrow_band.hpp"
 #include "surface/surface_result.hpp"
 
@@ -89,7 +90,8 @@ struct EvolveArgs {
   int rk = 1;
   double cfl = 0.0;                // 0: 0.5 for --rk 1, 0.9 for --rk 3
   int redistance_every = 0;
-  double drift_tolerance = 0.0;
+  double drift_tolerance = evolve::kDefaultDriftTolerance;
+  double band_growth_limit = evolve::kDefaultBandGrowthLimit;
   bool extension = false;
   int report_every = 0;            // print a progress line every N steps (0: none)
   std::string stats;

@@ -44,6 +44,7 @@ int run_evolve(const EvolveArgs& args) {
   options.time = args.time;
   options.redistance_every = args.redistance_every;
   options.drift_tolerance = args.drift_tolerance;
+  options.band_growth_limit = args.band_growth_limit;
   options.extension = args.extension;
   std::FILE* out = summary_stream(args.stats);
   if (args.report_every > 0)
@@ -63,6 +64,7 @@ int run_evolve(const EvolveArgs& args) {
                args.input.c_str(), result.steps, result.time, evolve::to_string(result.stop).data(), in.band.active_voxel_count(),
                result.band.active_voxel_count(), result.redistance_count, secs(t1, t2), args.output.c_str(),
                human_bytes(written.file_bytes).c_str());
+  if (result.stop == evolve::StopReason::Vanished) std::fprintf(out, "%s\n", result.message.c_str());
   Stats stats("evolve", result.band);
   stats.seconds["read"] = secs(t0, t1);
   stats.seconds["evolve"] = secs(t1, t2);
@@ -84,6 +86,7 @@ int run_evolve(const EvolveArgs& args) {
   stats.extra["time"] = result.time;
   stats.extra["stop"] = evolve::to_string(result.stop).data();
   stats.extra["redistance_count"] = result.redistance_count;
+  stats.extra["growth_redistance_count"] = result.growth_redistance_count;
   stats.extra["landmine_count"] = result.landmine_count;
   stats.extra["activated"] = result.activated;
   stats.extra["retired"] = result.retired;

@@ -178,7 +178,7 @@ int run_info(const InfoArgs& args) {
   }
   j["file"] = args.path;
   if (args.json) {
-    std::cout << j.dump(2) << "\n";
+    std::cout << json_text(j) << "\n";
   } else {
     print_human(args.path, j);
   }

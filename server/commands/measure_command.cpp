@@ -5,6 +5,7 @@
 #include <nlohmann/json.hpp>
 
 #include "commands/commands.hpp"
+#include "commands/report.hpp"
 #include "grid/lsg_file.hpp"
 #include "surface/mesh_measures.hpp"
 
@@ -33,7 +34,7 @@ int run_measure(const MeasureArgs& args) {
     j["bounds"] = {{"min", {m.bounds.min.x, m.bounds.min.y, m.bounds.min.z}},
                    {"max", {m.bounds.max.x, m.bounds.max.y, m.bounds.max.z}}};
   if (args.json) {
-    std::cout << j.dump(2) << "\n";
+    std::cout << json_text(j) << "\n";
     return 0;
   }
   std::printf("file:            %s (iso %g, %s)\n", args.input.c_str(), args.iso, args.method.c_str());

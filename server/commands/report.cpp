@@ -35,9 +35,13 @@ nlohmann::json Stats::to_json() const {
   return j;
 }
 
+std::string json_text(const nlohmann::json& j) {
+  return j.dump(2, ' ', false, nlohmann::json::error_handler_t::replace);
+}
+
 void write_stats(const Stats& stats, const std::string& path) {
   if (path.empty()) return;
-  const std::string text = stats.to_json().dump(2) + "\n";
+  const std::string text = json_text(stats.to_json()) + "\n";
   if (path == "-") {
     std::cout << text;
   } else {

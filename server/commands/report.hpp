@@ -43,6 +43,10 @@ struct Stats {
 // Writes stats to path ("-" = stdout); no-op for an empty path.
 void write_stats(const Stats& stats, const std::string& path);
 
+// JSON text (indent 2) that is valid UTF-8 whatever the strings hold: bytes of file names or
+// formulas that are not UTF-8 become U+FFFD instead of a json type_error.
+std::string json_text(const nlohmann::json& j);
+
 std::string human_bytes(std::uint64_t bytes);
 
 // Where the one-line human summary goes: stderr when --stats writes JSON to stdout ("-"),

@@ -4,6 +4,7 @@
 #include <memory>
 
 #include "commands/command.hpp"
+#include "commands/report.hpp"
 #include "core/error.hpp"
 #include "jobs/job.hpp"
 
@@ -47,11 +48,11 @@ Command add_run_command(CLI::App& app, int& threads) {
                          result.seconds);
             for (const std::string& path : result.outputs) std::fprintf(out, "  %s\n", path.c_str());
             if (args->stats == "-") {
-              std::printf("%s\n", result.stats.dump(2, ' ', false, nlohmann::json::error_handler_t::replace).c_str());
+              std::printf("%s\n", json_text(result.stats).c_str());
             } else if (!args->stats.empty()) {
               std::FILE* f = std::fopen(args->stats.c_str(), "w");
               if (f == nullptr) throw Error(ErrorCode::IoError, args->stats, "cannot write the stats");
-              std::fprintf(f, "%s\n", result.stats.dump(2, ' ', false, nlohmann::json::error_handler_t::replace).c_str());
+              std::fprintf(f, "%s\n", json_text(result.stats).c_str());
               std::fclose(f);
             }
             return 0;

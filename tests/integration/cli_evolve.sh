@@ -47,8 +47,40 @@ pass
 [ "$(radius "$dir/f1.lsg")" = "$(radius "$dir/f2.lsg")" ] || fail "formula and built-in differ"
 pass
 
+# Long runs with the defaults (issue 13): 100 mean-curvature steps of a sphere at R = 64 once
+# grew the band 5x (drift 0.64); the band now stays within 1.5x of its start and the drift
+# near the surface small. A sphere run past its vanishing time stops as 'vanished', empty.
+"$bin" primitive sphere --resolution 64 --band 3 -o "$dir/s64.lsg" > /dev/null || fail "primitive R=64"
+"$bin" evolve "$dir/s64.lsg" -o "$dir/mcf100.lsg" --speed '-(k1+k2)' --steps 100 --threads 1 \
+  --stats "$dir/mcf100.json" > /dev/null || fail "evolve 100 mean-curvature steps"
+$py - "$dir/mcf100.json" <<'PY' || fail "100 mean-curvature steps: band or drift"
+import json, sys
+s = json.load(open(sys.argv[1]))
+assert s["stop"] == "completed" and s["steps"] == 100, s
+assert s["active_voxels"] <= 1.5 * 63582, s["active_voxels"]
+assert s["grad_drift"] < 0.05, s["grad_drift"]
+PY
+pass
+"$bin" evolve "$dir/sphere.lsg" -o "$dir/gone.lsg" --speed mean-curvature --steps 3000 \
+  --stats "$dir/gone.json" > "$dir/gone.txt" || fail "evolve past vanishing"
+$py - "$dir/gone.json" <<'PY' || fail "vanishing sphere: $(cat "$dir/gone.txt")"
+import json, sys
+s = json.load(open(sys.argv[1]))
+assert s["stop"] == "vanished" and s["steps"] < 3000 and s["active_voxels"] == 0, s
+assert abs(s["time"] - 0.25) < 0.02, s["time"]
+PY
+grep -q "vanished after" "$dir/gone.txt" || fail "no vanishing message"
+pass
+
 # Errors: usage (exit 2) and typed errors (exit 1).
 set +e
+"$bin" evolve "$dir/sphere.lsg" -o "$dir/x.lsg" --speed $'\xc3\xa9+1' --steps 3 2> "$dir/err0.txt"; code=$?
+[ $code -eq 1 ] && grep -qF $'unexpected character \'\xc3\xa9\' (U+00E9)' "$dir/err0.txt" \
+  && iconv -f UTF-8 -t UTF-8 "$dir/err0.txt" > /dev/null || fail "non-ASCII in a formula: exit $code, $(cat "$dir/err0.txt")"
+pass
+"$bin" evolve "$dir/sphere.lsg" -o "$dir/x.lsg" --speed $'1\xff' --steps 3 2> "$dir/err0b.txt"; code=$?
+[ $code -eq 1 ] && iconv -f UTF-8 -t UTF-8 "$dir/err0b.txt" > /dev/null || fail "invalid UTF-8 in a formula: exit $code"
+pass
 "$bin" evolve "$dir/sphere.lsg" -o "$dir/x.lsg" --speed warp --steps 3 2> "$dir/err1.txt"; code=$?
 [ $code -eq 1 ] && grep -q "unknown name 'warp'" "$dir/err1.txt" && grep -q '^  \^' "$dir/err1.txt" \
   || fail "unknown speed name: exit $code, $(cat "$dir/err1.txt")"; pass

@@ -371,6 +371,10 @@ TEST(Evolution, FormulasEvolveLikeHandWrittenSpeeds) {
     hand.diffusion = f.diffusion;  // same time steps
     EvolutionOptions o;
     o.steps = 5;
+    // The operators are compared, not the redistance schedule: a drift on the tolerance's
+    // edge may trigger in one run and not in the other.
+    o.drift_tolerance = 0;
+    o.band_growth_limit = 0;
     o.fields = fields;
     o.speed = f;
     const NarrowBand a = evolve(band, o).band;
@@ -381,7 +385,11 @@ TEST(Evolution, FormulasEvolveLikeHandWrittenSpeeds) {
     for (std::size_t i = 0; i < a.values().size(); ++i)
       worst = std::max(worst, double(std::abs(a.values()[i] - b.values()[i])));
     std::printf("%-28s max |difference| %.3g\n", c.formula, worst);
-    EXPECT_LE(worst, 1e-6) << c.formula;
+    // Equal up to rounding, except that rounding (dn is formed in double by the formula, in
+    // float by hand) can break a tie differently where a voxel near the band's edge takes its
+    // curvature from the nearer of two equally near neighbours (evolution.hpp); five steps
+    // carry that inward as a few 1e-3 of a voxel.
+    EXPECT_LE(worst, 1e-2 * band.voxel_size()) << c.formula;
   }
 }
 
