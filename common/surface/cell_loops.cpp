@@ -51,7 +51,8 @@ LoopSet trace(int m, int decisions) {
   std::array<int, 12> next;
   next.fill(-1);
   // Which face holds both segments of a 4-crossing face: pairs of entry edges per face.
-  std::vector<std::array<int, 3>> doubled;  // entry edges and face
+  std::array<std::array<int, 3>, 6> doubled;  // entry edges and face, per 4-crossing face
+  int doubled_count = 0;
   for (int f = 0; f < 6; ++f) {
     std::array<int, 4> c = face_corners(f);
     // Counter-clockwise seen from outside the cell. The canonical order turns about +axis for
@@ -86,7 +87,7 @@ LoopSet trace(int m, int decisions) {
       next[edges[i]] = connected ? edges[(i + 3) & 3] : edges[(i + 1) & 3];
       pair[k++] = edges[i];
     }
-    doubled.push_back(pair);
+    doubled[std::size_t(doubled_count++)] = pair;
   }
   int pos = 0;
   for (int e0 = 0; e0 < 12; ++e0) {
@@ -101,19 +102,38 @@ LoopSet trace(int m, int decisions) {
     } while (e != e0);
     s.length[l] = std::uint8_t(pos - s.begin[l]);
   }
-  for (const auto& p : doubled)
+  for (int k = 0; k < doubled_count; ++k) {
+    const std::array<int, 3>& p = doubled[std::size_t(k)];
     if (s.loop_of_edge[p[0]] == s.loop_of_edge[p[1]]) {
       s.doubled_face_loops |= std::uint8_t(1u << s.loop_of_edge[p[0]]);
       s.doubled_faces[s.loop_of_edge[p[0]]] |= std::uint8_t(1u << p[2]);
     }
+  }
   return s;
 }
 
+// Faces of inside mask m with 4 crossings (the only ones whose decision bit matters).
+int ambiguous_faces(int m) {
+  int faces = 0;
+  for (int f = 0; f < 6; ++f) {
+    const std::array<int, 4> c = face_corners(f);
+    const int in0 = (m >> c[0]) & 1, in1 = (m >> c[1]) & 1, in2 = (m >> c[2]) & 1, in3 = (m >> c[3]) & 1;
+    if (in0 == in2 && in1 == in3 && in0 != in1) faces |= 1 << f;
+  }
+  return faces;
+}
+
+// Built on first use: traced once per distinct decision pattern (the decisions on faces that
+// are not ambiguous do not matter and copy the traced set), about 1/10 of the 16384 entries,
+// so a cold process's first extraction does not pay ~5 ms for the table (issue 13).
 struct Table {
   std::vector<LoopSet> sets;
   Table() : sets(256 * 64) {
-    for (int m = 0; m < 256; ++m)
-      for (int d = 0; d < 64; ++d) sets[m * 64 + d] = trace(m, d);
+    for (int m = 0; m < 256; ++m) {
+      const int amb = ambiguous_faces(m);
+      for (int d = 0; d < 64; ++d)
+        sets[std::size_t(m * 64 + d)] = (d & amb) == d ? trace(m, d) : sets[std::size_t(m * 64 + (d & amb))];
+    }
   }
 };
 
