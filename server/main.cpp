@@ -11,7 +11,9 @@
 #include "commands/command.hpp"
 #include "commands/commands.hpp"
 #include "core/error.hpp"
+#include "core/file_io.hpp"
 #include "core/text.hpp"
+#include "commands/output_check.hpp"
 #include "evolve/speed.hpp"
 #include "geometry/analytic_shapes.hpp"
 
@@ -21,6 +23,10 @@ int main(int argc, char** argv) {
   CLI::App app{"levelsetd: narrow-band level-set computation (batch subcommands; daemon to come)"};
   app.set_version_flag("--version", std::string("levelsetd ") + LEVELSET_VERSION);
   app.require_subcommand(1);
+  bool allow_special = false;
+  app.add_flag("--allow-special-outputs", allow_special,
+               "Let outputs write into an existing character device or FIFO (e.g. --stats /dev/stdout); "
+               "without it such destinations, and symbolic links, are refused");
   int threads = 0;
 
   levelset::cli::InfoArgs info;
@@ -142,7 +148,13 @@ int main(int argc, char** argv) {
   std::optional<tbb::global_control> limit;
   if (threads > 0) limit.emplace(tbb::global_control::max_allowed_parallelism, threads);
 
+  // Outputs never clobber: no symlink or special file replaced, no input overwritten (checked
+  // here before any work, and again at each write), no temp file left by Ctrl-C.
+  levelset::remove_temp_files_on_signals();
+  levelset::enable_output_guard(true);
+  levelset::allow_special_outputs(allow_special);
   try {
+    for (const CLI::App* sub : app.get_subcommands()) levelset::cli::check_command_files(*sub);
     if (*info_cmd) return levelset::cli::run_info(info);
     if (*prim_cmd) return levelset::cli::run_primitive(prim);
     if (*cpt_cmd) return levelset::cli::run_cpt(cpt);

@@ -1,18 +1,128 @@
 #include "core/file_io.hpp"
 
 #include <fcntl.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <atomic>
 #include <cerrno>
+#include <csignal>
 #include <cstring>
 #include <fstream>
+#include <mutex>
+#include <set>
+#include <utility>
 
 #include "core/error.hpp"
 
 namespace levelset {
 
 namespace fs = std::filesystem;
+
+namespace {
+
+using Identity = std::pair<dev_t, ino_t>;
+
+std::atomic<bool> g_allow_special{false};
+std::atomic<bool> g_guard{false};
+
+// Files this process read and wrote (while the guard is on).
+struct Seen {
+  std::mutex mutex;
+  std::set<Identity> read, written;
+};
+Seen& seen() {
+  static Seen s;
+  return s;
+}
+
+bool identity_of(const fs::path& path, Identity& id) {
+  struct stat st{};
+  if (::stat(path.c_str(), &st) != 0) return false;
+  id = {st.st_dev, st.st_ino};
+  return true;
+}
+
+// Temp files of writes in progress, for the signal handler: fixed slots of plain chars (a
+// handler may not allocate or lock). A write that finds no free slot still works; only its
+// cleanup on a signal is lost.
+constexpr int kSlots = 64;
+constexpr std::size_t kSlotBytes = 4096;
+char g_temp_paths[kSlots][kSlotBytes];
+std::atomic<int> g_temp_state[kSlots];  // 0 free, 1 being filled, 2 live
+
+int register_temp(const std::string& path) {
+  if (path.size() >= kSlotBytes) return -1;
+  for (int i = 0; i < kSlots; ++i) {
+    int expected = 0;
+    if (g_temp_state[i].compare_exchange_strong(expected, 1)) {
+      std::memcpy(g_temp_paths[i], path.c_str(), path.size() + 1);
+      g_temp_state[i].store(2);
+      return i;
+    }
+  }
+  return -1;
+}
+
+void release_temp(int slot) {
+  if (slot >= 0) g_temp_state[slot].store(0);
+}
+
+extern "C" void remove_temps_and_reraise(int sig) {
+  for (int i = 0; i < kSlots; ++i)
+    if (g_temp_state[i].load() == 2) ::unlink(g_temp_paths[i]);
+  std::signal(sig, SIG_DFL);
+  std::raise(sig);
+}
+
+// The destination's kind, checked before anything is written. Returns true when the path is
+// an allowed special file to be written in place.
+bool check_destination(const fs::path& path) {
+  struct stat st{};
+  if (::lstat(path.c_str(), &st) != 0) return false;  // does not exist (or cannot be seen): created
+  if (S_ISLNK(st.st_mode))
+    throw Error(ErrorCode::IoError, path.string(),
+                "is a symbolic link; refusing to replace it (write to its target's path instead)");
+  if (S_ISREG(st.st_mode)) {
+    if (g_guard.load()) {
+      Seen& s = seen();
+      std::lock_guard lock(s.mutex);
+      const Identity id{st.st_dev, st.st_ino};
+      if (s.read.count(id))
+        throw Error(ErrorCode::IoError, path.string(), "is an input of this run; refusing to overwrite it");
+      if (s.written.count(id))
+        throw Error(ErrorCode::IoError, path.string(), "was already written by this run (two outputs to one file)");
+    }
+    return false;
+  }
+  if (g_allow_special.load() && (S_ISCHR(st.st_mode) || S_ISFIFO(st.st_mode))) return true;
+  throw Error(ErrorCode::IoError, path.string(),
+              std::string("exists and is not a regular file (") +
+                  (S_ISDIR(st.st_mode) ? "a directory" : S_ISCHR(st.st_mode) || S_ISBLK(st.st_mode) ? "a device"
+                                                      : S_ISFIFO(st.st_mode)                            ? "a FIFO"
+                                                                                                        : "a special file") +
+                  "); refusing to replace it");
+}
+
+void write_all(int fd, const fs::path& path, std::string_view bytes, const char* cleanup) {
+  std::size_t done = 0;
+  while (done < bytes.size()) {
+    const ssize_t n = ::write(fd, bytes.data() + done, bytes.size() - done);
+    if (n < 0) {
+      if (errno == EINTR) continue;
+      const int err = errno;
+      ::close(fd);
+      if (cleanup) ::unlink(cleanup);
+      throw Error(ErrorCode::IoError, path.string(), std::string("write failed: ") + std::strerror(err));
+    }
+    done += static_cast<std::size_t>(n);
+  }
+}
+
+}  // namespace
+
+void allow_special_outputs(bool on) { g_allow_special.store(on); }
+void enable_output_guard(bool on) { g_guard.store(on); }
 
 std::string read_file_bytes(const fs::path& path, std::uint64_t max_bytes) {
   std::error_code ec;
@@ -28,6 +138,13 @@ std::string read_file_bytes(const fs::path& path, std::uint64_t max_bytes) {
                 "file is " + std::to_string(size) + " bytes, limit is " + std::to_string(max_bytes));
   std::ifstream in(path, std::ios::binary);
   if (!in) throw Error(ErrorCode::IoError, path.string(), "cannot open for reading");
+  if (g_guard.load()) {
+    Identity id;
+    if (identity_of(path, id)) {
+      std::lock_guard lock(seen().mutex);
+      seen().read.insert(id);
+    }
+  }
   std::string bytes(size, '\0');
   in.read(bytes.data(), static_cast<std::streamsize>(size));
   if (static_cast<std::uint64_t>(in.gcount()) != size)
@@ -36,34 +153,90 @@ std::string read_file_bytes(const fs::path& path, std::uint64_t max_bytes) {
 }
 
 void write_file_atomically(const fs::path& path, std::string_view bytes) {
+  if (check_destination(path)) {
+    // An allowed character device or FIFO: written in place, nothing to rename.
+    const int fd = ::open(path.c_str(), O_WRONLY | O_CLOEXEC | O_NOFOLLOW);
+    if (fd < 0) throw Error(ErrorCode::IoError, path.string(), std::string("cannot open: ") + std::strerror(errno));
+    write_all(fd, path, bytes, nullptr);
+    ::close(fd);
+    return;
+  }
   static std::atomic<unsigned> counter{0};
   const fs::path tmp = path.string() + ".tmp-" + std::to_string(::getpid()) + "-" +
                        std::to_string(counter.fetch_add(1));
-  const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
-  if (fd < 0)
-    throw Error(ErrorCode::IoError, path.string(),
-                std::string("cannot create temporary file: ") + std::strerror(errno));
-  std::size_t done = 0;
-  while (done < bytes.size()) {
-    const ssize_t n = ::write(fd, bytes.data() + done, bytes.size() - done);
-    if (n < 0) {
-      if (errno == EINTR) continue;
-      const int err = errno;
-      ::close(fd);
-      ::unlink(tmp.c_str());
-      throw Error(ErrorCode::IoError, path.string(), std::string("write failed: ") + std::strerror(err));
+  const int slot = register_temp(tmp.string());
+  const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC | O_NOFOLLOW, 0644);
+  if (fd < 0) {
+    const int err = errno;
+    release_temp(slot);
+    throw Error(ErrorCode::IoError, path.string(), std::string("cannot create temporary file: ") + std::strerror(err));
+  }
+  try {
+    write_all(fd, path, bytes, tmp.c_str());
+  } catch (...) {
+    release_temp(slot);
+    throw;
+  }
+  auto fail = [&](const char* what) {
+    const int err = errno;
+    ::unlink(tmp.c_str());
+    release_temp(slot);
+    throw Error(ErrorCode::IoError, path.string(), std::string(what) + std::strerror(err));
+  };
+  if (::fsync(fd) != 0) {
+    ::close(fd);
+    fail("flush failed: ");
+  }
+  if (::close(fd) != 0) fail("flush failed: ");
+  // The destination may have changed while we wrote (another process): checked again.
+  try {
+    check_destination(path);
+  } catch (...) {
+    ::unlink(tmp.c_str());
+    release_temp(slot);
+    throw;
+  }
+  if (::rename(tmp.c_str(), path.c_str()) != 0) fail("rename failed: ");
+  release_temp(slot);
+  if (g_guard.load()) {
+    Identity id;
+    if (identity_of(path, id)) {
+      std::lock_guard lock(seen().mutex);
+      seen().written.insert(id);
     }
-    done += static_cast<std::size_t>(n);
   }
-  if (::fsync(fd) != 0 || ::close(fd) != 0) {
-    const int err = errno;
-    ::unlink(tmp.c_str());
-    throw Error(ErrorCode::IoError, path.string(), std::string("flush failed: ") + std::strerror(err));
+}
+
+void check_output_paths(const std::vector<fs::path>& inputs, const std::vector<fs::path>& outputs) {
+  std::set<Identity> input_ids;
+  for (const fs::path& in : inputs) {
+    Identity id;
+    if (identity_of(in, id)) input_ids.insert(id);
   }
-  if (::rename(tmp.c_str(), path.c_str()) != 0) {
-    const int err = errno;
-    ::unlink(tmp.c_str());
-    throw Error(ErrorCode::IoError, path.string(), std::string("rename failed: ") + std::strerror(err));
+  std::set<Identity> output_ids;
+  std::set<fs::path> output_paths;
+  for (const fs::path& out : outputs) {
+    check_destination(out);
+    Identity id;
+    if (identity_of(out, id)) {
+      if (input_ids.count(id)) throw Error(ErrorCode::IoError, out.string(), "is also an input; refusing to overwrite it");
+      if (!output_ids.insert(id).second)
+        throw Error(ErrorCode::IoError, out.string(), "is named by two outputs; give each output its own file");
+    }
+    std::error_code ec;
+    const fs::path norm = fs::weakly_canonical(fs::absolute(out, ec), ec);
+    if (!ec && !output_paths.insert(norm).second)
+      throw Error(ErrorCode::IoError, out.string(), "is named by two outputs; give each output its own file");
+  }
+}
+
+void remove_temp_files_on_signals() {
+  for (int sig : {SIGINT, SIGTERM, SIGHUP}) {
+    struct sigaction sa{};
+    sa.sa_handler = remove_temps_and_reraise;
+    sigemptyset(&sa.sa_mask);
+    sa.sa_flags = SA_RESETHAND;
+    ::sigaction(sig, &sa, nullptr);
   }
 }
 

@@ -165,6 +165,23 @@ expect_absent "$DIR/no" "primitive into a missing directory created it"
 leftovers=$(find "$DIR" -name '*.tmp-*' | wc -l)
 if [[ $leftovers -eq 0 ]]; then pass; else soft_fail "$leftovers temporary files left in $DIR"; fi
 
+# Outputs never clobber (issue 14): no device or symlink replaced, no input overwritten, no
+# two outputs to one file; each refused before any work, leaving the file as it was.
+run_ok clobber_knot primitive knot --resolution 24 --band 3 -o "$DIR/clobber.lsg"
+before=$(sha256sum "$DIR/clobber.lsg")
+mkfifo "$DIR/clobber.fifo"
+ln -sf "$DIR/elsewhere.lsg" "$DIR/clobber_link.lsg"
+run_fail clobber_fifo "not a regular file" primitive knot --resolution 24 --band 3 -o "$DIR/clobber.fifo"
+[[ -p "$DIR/clobber.fifo" ]] && pass || soft_fail "the FIFO was replaced"
+run_fail clobber_link "symbolic link" primitive knot --resolution 24 --band 3 -o "$DIR/clobber_link.lsg"
+[[ -L "$DIR/clobber_link.lsg" && ! -e "$DIR/elsewhere.lsg" ]] && pass || soft_fail "the symlink was replaced or followed"
+run_fail clobber_input "also an input" redistance "$DIR/clobber.lsg" --method sweep -o "$DIR/clobber.lsg"
+run_fail clobber_stats "also an input" mesh "$DIR/clobber.lsg" -o "$DIR/clobber.ply" --stats "$DIR/clobber.lsg"
+run_fail clobber_twice "two outputs" mesh "$DIR/clobber.lsg" -o "$DIR/clobber.ply" --stats "$DIR/./clobber.ply"
+[[ "$(sha256sum "$DIR/clobber.lsg")" == "$before" ]] && pass || soft_fail "the input changed"
+expect_absent "$DIR/clobber.ply" "an output was written although the command was refused"
+ls "$DIR"/*.tmp-* >/dev/null 2>&1 && soft_fail "temp files left behind" || pass
+
 if [[ $failures -gt 0 ]]; then
   echo "cli_roundtrip: $failures checks FAILED, $checks passed" >&2
   exit 1
