@@ -19,9 +19,11 @@
 #include <cstring>
 #include <string>
 #include <string_view>
+#include <unordered_set>
 #include <vector>
 
 #include "core/error.hpp"
+#include "core/text.hpp"
 #include "io/text_scanner.hpp"
 
 namespace levelset::ply {
@@ -50,6 +52,40 @@ inline std::size_t type_size(Type t) {
 
 inline bool is_integer(Type t) {
   return t != Type::Float32 && t != Type::Float64;
+}
+
+// The range of an integer type, as doubles (exact for every type here).
+inline double type_min(Type t) {
+  switch (t) {
+    case Type::Int8: return -128.0;
+    case Type::Int16: return -32768.0;
+    case Type::Int32: return -2147483648.0;
+    default: return 0.0;
+  }
+}
+inline double type_max(Type t) {
+  switch (t) {
+    case Type::Int8: return 127.0;
+    case Type::UInt8: return 255.0;
+    case Type::Int16: return 32767.0;
+    case Type::UInt16: return 65535.0;
+    case Type::Int32: return 2147483647.0;
+    default: return 4294967295.0;
+  }
+}
+
+inline std::string_view type_name(Type t) {
+  switch (t) {
+    case Type::Int8: return "char";
+    case Type::UInt8: return "uchar";
+    case Type::Int16: return "short";
+    case Type::UInt16: return "ushort";
+    case Type::Int32: return "int";
+    case Type::UInt32: return "uint";
+    case Type::Float32: return "float";
+    case Type::Float64: return "double";
+  }
+  return "?";
 }
 
 inline bool parse_type(std::string_view s, Type& t) {
@@ -107,9 +143,18 @@ struct Header {
   }
 };
 
+// Header caps. Real files have a handful of elements and at most a few hundred properties
+// (3D Gaussian splat files: about 60); the caps keep a hostile header from costing more than a
+// small, fixed amount of memory and time.
+inline constexpr std::size_t kMaxElements = 1024;
+inline constexpr std::size_t kMaxPropertiesPerElement = 4096;
+
+// Linear in the header's size: duplicate names are found with hash sets, not by scanning.
 inline Header parse_header(std::string_view bytes, std::string_view name) {
   TextScanner sc(bytes, name);
   Header h;
+  std::unordered_set<std::string> element_names;
+  std::unordered_set<std::string> property_names;  // of the last element
   {
     const std::string_view magic = sc.line_token();
     if (magic != "ply")
@@ -155,8 +200,12 @@ inline Header parse_header(std::string_view bytes, std::string_view name) {
       const std::string_view ename = sc.line_token();
       if (ename.empty()) sc.fail_missing("an element name");
       e.name = std::string(ename);
-      if (h.find(e.name) != nullptr)
-        sc.fail(ErrorCode::ParseError, "element '" + e.name + "' declared twice");
+      if (h.elements.size() >= kMaxElements)
+        sc.fail(ErrorCode::LimitExceeded,
+                "more than " + std::to_string(kMaxElements) + " elements in the PLY header");
+      if (!element_names.insert(e.name).second)
+        sc.fail(ErrorCode::ParseError, "element '" + TextScanner::quote(e.name) + "' declared twice");
+      property_names.clear();
       e.count = sc.parse_count(sc.line_token(), "the element count");
       sc.expect_end_of_line("the element count");
       h.elements.push_back(std::move(e));
@@ -185,9 +234,12 @@ inline Header parse_header(std::string_view bytes, std::string_view name) {
       if (pname.empty()) sc.fail_missing("a property name");
       p.name = std::string(pname);
       Element& e = h.elements.back();
-      if (e.find(p.name) >= 0)
+      if (e.properties.size() >= kMaxPropertiesPerElement)
+        sc.fail(ErrorCode::LimitExceeded, "more than " + std::to_string(kMaxPropertiesPerElement) +
+                                              " properties in element '" + TextScanner::quote(e.name) + "'");
+      if (!property_names.insert(p.name).second)
         sc.fail(ErrorCode::ParseError,
-                "property '" + p.name + "' declared twice in element '" + e.name + "'");
+                "property '" + TextScanner::quote(p.name) + "' declared twice in element '" + TextScanner::quote(e.name) + "'");
       sc.expect_end_of_line("the property name");
       e.properties.push_back(std::move(p));
     } else if (kw == "end_header") {
@@ -268,7 +320,9 @@ class BodyReader {
   double read_number(Type t, std::string_view what) {
     if (ascii()) {
       const std::string_view tok = scanner_.next_token();
-      return scanner_.parse_any_number(tok, what);
+      const double v = scanner_.parse_any_number(tok, what);
+      if (is_integer(t)) check_ascii_range(t, v, tok, what);
+      return v;
     }
     start_ = pos_;
     switch (t) {
@@ -296,7 +350,9 @@ class BodyReader {
   std::int64_t read_integer(Type t, std::string_view what) {
     if (ascii()) {
       const std::string_view tok = scanner_.next_token();
-      return scanner_.parse_int(tok, what);
+      const std::int64_t v = scanner_.parse_int(tok, what);
+      if (is_integer(t)) check_ascii_range(t, static_cast<double>(v), tok, what);
+      return v;
     }
     start_ = pos_;
     switch (t) {
@@ -373,11 +429,24 @@ class BodyReader {
   }
 
  private:
+  // ASCII values carry no width: refuse ones outside the declared integer type (300 or -1 for a
+  // uchar), as a binary file could not hold them.
+  void check_ascii_range(Type t, double v, std::string_view tok, std::string_view what) const {
+    if (v >= type_min(t) && v <= type_max(t)) return;
+    scanner_.fail(ErrorCode::ParseError,
+                  std::string(what) + " '" + TextScanner::quote(tok) + "' does not fit the type " +
+                      std::string(type_name(t)) + " (" + format_number(type_min(t)) + " to " +
+                      format_number(type_max(t)) + ")");
+  }
+
   void skip_value(Type t) {
     if (ascii()) {
       const std::string_view tok = scanner_.next_token();
       if (tok.empty()) scanner_.fail_missing("a property value");
       if (!TextScanner::is_number(tok)) scanner_.fail_expected("a property value", "a number", tok);
+      if (is_integer(t))
+        check_ascii_range(t, scanner_.parse_any_number(tok, "a property value"), tok,
+                          "a property value");
       return;
     }
     start_ = pos_;

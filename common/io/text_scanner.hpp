@@ -144,7 +144,7 @@ class TextScanner {
     if (!to_double(tok, value)) fail_expected(what, "a number", tok);
     if (!std::isfinite(value))
       fail(ErrorCode::NonFinite,
-           "expected a finite " + std::string(what) + ", found '" + quote(tok) + "'");
+           "expected a finite number for " + std::string(what) + ", found '" + quote(tok) + "'");
     return value;
   }
 

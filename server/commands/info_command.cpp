@@ -11,8 +11,10 @@
 #include "commands/report.hpp"
 #include "core/error.hpp"
 #include "grid/lsg_file.hpp"
-#include "io/mesh_reader.hpp"
+#include "core/file_io.hpp"
 #include "io/image_reader.hpp"
+#include "io/mesh_reader.hpp"
+#include "io/ply_parser.hpp"
 #include "io/point_cloud_reader.hpp"
 
 namespace levelset::cli {
@@ -61,8 +63,7 @@ json lsg_info(const std::string& path) {
   return j;
 }
 
-json mesh_info(const std::string& path) {
-  const MeshReadResult r = read_mesh(path);
+json mesh_info(const MeshReadResult& r) {
   json j;
   j["kind"] = "mesh";
   j["format"] = std::string(to_string(r.format));
@@ -74,8 +75,7 @@ json mesh_info(const std::string& path) {
   return j;
 }
 
-json cloud_info(const std::string& path) {
-  const PointCloudReadResult r = read_point_cloud(path);
+json cloud_info(const PointCloudReadResult& r) {
   json j;
   j["kind"] = "point_cloud";
   j["format"] = std::string(to_string(r.format));
@@ -155,21 +155,17 @@ int run_info(const InfoArgs& args) {
   if (ext == ".lsg") {
     j = lsg_info(args.path);
   } else if (ext == ".xyz" || ext == ".xyzn" || ext == ".pwn") {
-    j = cloud_info(args.path);
+    j = cloud_info(read_point_cloud(args.path));
   } else if (ext == ".ply") {
-    // A PLY with a face element is a mesh; one with vertices only is a point cloud.
-    try {
-      j = mesh_info(args.path);
-    } catch (const Error& mesh_error) {
-      if (mesh_error.code() != ErrorCode::ParseError) throw;
-      try {
-        j = cloud_info(args.path);
-      } catch (const Error&) {
-        throw mesh_error;
-      }
-    }
+    // The header decides: a PLY with a face element is a mesh, read (and refused) exactly as
+    // cpt reads it; one without is a point cloud.
+    const std::string bytes = read_file_bytes(args.path, MeshReadOptions{}.max_file_bytes);
+    if (ply::parse_header(bytes, args.path).find("face") != nullptr)
+      j = mesh_info(read_mesh_from_memory(bytes, args.path));
+    else
+      j = cloud_info(read_point_cloud_from_memory(bytes, args.path));
   } else if (ext == ".off" || ext == ".tria" || ext == ".obj" || ext == ".stl") {
-    j = mesh_info(args.path);
+    j = mesh_info(read_mesh(args.path));
   } else if (ext == ".inr" || ext == ".nrrd" || ext == ".nhdr" || ext == ".gz") {
     j = image_info(args.path);
   } else {
