@@ -8,6 +8,7 @@
 #include <CLI/CLI.hpp>
 #include <tbb/global_control.h>
 
+#include "commands/number_checks.hpp"
 #include "commands/command.hpp"
 #include "commands/commands.hpp"
 #include "core/error.hpp"
@@ -42,9 +43,9 @@ int main(int argc, char** argv) {
       ->check(CLI::IsMember(levelset::builtin_shape_names()));
   prim_cmd->add_option("--resolution,-r", prim.resolution,
                        "Voxels along the longest side of the padded bounding box")
-      ->check(CLI::Range(8, 1 << 15));
-  prim_cmd->add_option("--band,-b", prim.band, "Band half-width in voxels")->check(CLI::Range(1.0, 64.0));
-  prim_cmd->add_option("-o,--output", prim.output, "Output .lsg file")->required();
+      ->transform(levelset::cli::in_range(8, 1 << 15));
+  prim_cmd->add_option("--band,-b", prim.band, "Band half-width in voxels")->transform(levelset::cli::in_range(1.0, 64.0));
+  prim_cmd->add_option("-o,--output", prim.output, "Output .lsg file")->required()->check(levelset::cli::lsg_output());
   add_common_options(prim_cmd, threads, prim.stats);
 
   levelset::cli::CptArgs cpt;
@@ -52,13 +53,13 @@ int main(int argc, char** argv) {
   cpt_cmd->add_option("mesh", cpt.mesh, "Input mesh (.off .tria .ply .obj .stl)")->required();
   auto* res_opt = cpt_cmd->add_option("--resolution,-r", cpt.resolution,
                                       "Voxels along the longest side of the bounding box padded by the band")
-                      ->check(CLI::Range(8, 1 << 15));
+                      ->transform(levelset::cli::in_range(8, 1 << 15));
   auto* vs_opt = cpt_cmd->add_option("--voxel-size", cpt.voxel_size, "Voxel size in mesh units")
-                     ->check(CLI::PositiveNumber);
+                     ->transform(levelset::cli::positive());
   res_opt->excludes(vs_opt);
-  cpt_cmd->add_option("--band,-b", cpt.band, "Band half-width in voxels")->check(CLI::Range(1.0, 64.0));
+  cpt_cmd->add_option("--band,-b", cpt.band, "Band half-width in voxels")->transform(levelset::cli::in_range(1.0, 64.0));
   cpt_cmd->add_flag("--closest-points", cpt.closest_points, "Store the closest surface point per voxel");
-  cpt_cmd->add_option("-o,--output", cpt.output, "Output .lsg file")->required();
+  cpt_cmd->add_option("-o,--output", cpt.output, "Output .lsg file")->required()->check(levelset::cli::lsg_output());
   add_common_options(cpt_cmd, threads, cpt.stats);
 
   levelset::cli::RedistanceArgs redist;
@@ -67,11 +68,11 @@ int main(int argc, char** argv) {
   redist_cmd->add_option("--method", redist.method, "sweep (fast sweeping) or march (fast marching)")
       ->check(CLI::IsMember({"sweep", "march"}));
   redist_cmd->add_option("--band,-b", redist.band, "New band half-width in voxels (default: keep)")
-      ->check(CLI::Range(1.0, 64.0));
+      ->transform(levelset::cli::in_range(1.0, 64.0));
   redist_cmd->add_option("--order", redist.order,
                          "Upwind order: 1 (first-order Godunov, the thesis's) or 2 (second order)")
       ->check(CLI::IsMember({1, 2}));
-  redist_cmd->add_option("-o,--output", redist.output, "Output .lsg file")->required();
+  redist_cmd->add_option("-o,--output", redist.output, "Output .lsg file")->required()->check(levelset::cli::lsg_output());
   add_common_options(redist_cmd, threads, redist.stats);
 
   levelset::cli::SampleArgs sample;
@@ -83,7 +84,7 @@ int main(int argc, char** argv) {
   levelset::cli::MeshArgs mesh;
   CLI::App* mesh_cmd = app.add_subcommand("mesh", "Extract the iso-surface as a triangle mesh");
   mesh_cmd->add_option("input", mesh.input, "Input .lsg")->required();
-  mesh_cmd->add_option("-o,--output", mesh.output, "Output mesh (.ply .obj .off .stl)")->required();
+  mesh_cmd->add_option("-o,--output", mesh.output, "Output mesh (.ply .obj .off .stl)")->required()->check(levelset::cli::mesh_output());
   mesh_cmd->add_option("--iso", mesh.iso, "Iso value (inside the band)");
   mesh_cmd->add_option("--method", mesh.method, "mc (marching cubes) or nets (surface nets)")
       ->check(CLI::IsMember({"mc", "nets"}));
@@ -100,7 +101,7 @@ int main(int argc, char** argv) {
   levelset::cli::EvolveArgs evolve;
   CLI::App* evolve_cmd = app.add_subcommand("evolve", "Move the surface with a speed function (level set equation)");
   evolve_cmd->add_option("input", evolve.input, "Input .lsg")->required();
-  evolve_cmd->add_option("-o,--output", evolve.output, "Output .lsg file")->required();
+  evolve_cmd->add_option("-o,--output", evolve.output, "Output .lsg file")->required()->check(levelset::cli::lsg_output());
   std::string speed_help = "Speed: a formula (e.g. '1-eps*H', see the README) or a built-in name:";
   for (const std::string& n : levelset::evolve::builtin_speed_names()) speed_help += " " + n;
   evolve_cmd->add_option("--speed", evolve.speed, speed_help);
@@ -110,8 +111,8 @@ int main(int argc, char** argv) {
   evolve_cmd->add_option("--velocity", evolve.velocity, "Constant advection velocity x,y,z (world units per time)")
       ->delimiter(',')
       ->expected(3);
-  auto* steps_opt = evolve_cmd->add_option("--steps", evolve.steps, "Number of time steps")->check(CLI::PositiveNumber);
-  auto* time_opt = evolve_cmd->add_option("--time", evolve.time, "Evolve until this time")->check(CLI::PositiveNumber);
+  auto* steps_opt = evolve_cmd->add_option("--steps", evolve.steps, "Number of time steps")->transform(levelset::cli::positive_int());
+  auto* time_opt = evolve_cmd->add_option("--time", evolve.time, "Evolve until this time")->transform(levelset::cli::positive());
   steps_opt->excludes(time_opt);
   evolve_cmd->add_option("--scheme", evolve.scheme, "Spatial scheme: godunov (first order), eno2, weno5")
       ->check(CLI::IsMember({"godunov", "eno2", "weno5"}));
@@ -119,20 +120,20 @@ int main(int argc, char** argv) {
       ->check(CLI::IsMember({"godunov", "llf"}));
   evolve_cmd->add_option("--rk", evolve.rk, "Time integration: 1 (forward Euler) or 3 (TVD-RK3)")
       ->check(CLI::IsMember({1, 3}));
-  evolve_cmd->add_option("--cfl", evolve.cfl, "CFL number in (0, 1] (default 0.5 for --rk 1, 0.9 for --rk 3)")->check(CLI::Range(1e-6, 1.0));
+  evolve_cmd->add_option("--cfl", evolve.cfl, "CFL number in (0, 1] (default 0.5 for --rk 1, 0.9 for --rk 3)")->transform(levelset::cli::in_range(1e-6, 1.0));
   evolve_cmd->add_option("--redistance-every", evolve.redistance_every, "Redistance every K steps (0: never)")
-      ->check(CLI::NonNegativeNumber);
+      ->transform(levelset::cli::non_negative_int());
   evolve_cmd->add_option("--drift-tolerance", evolve.drift_tolerance,
                          "Redistance when the mean ||grad u| - 1| near the surface exceeds this (0: off)")
-      ->check(CLI::NonNegativeNumber)
+      ->transform(levelset::cli::non_negative())
       ->capture_default_str();
   evolve_cmd->add_option("--band-growth-limit", evolve.band_growth_limit,
                          "Redistance when the band holds more than this many times a fresh band's voxels (0: off, else >= 1)")
-      ->check(CLI::Range(0.0, 1e6))
+      ->transform(levelset::cli::in_range(0.0, 1e6))
       ->capture_default_str();
   evolve_cmd->add_flag("--extension", evolve.extension, "Extension velocities (speed constant along normals)");
   evolve_cmd->add_option("--report-every", evolve.report_every, "Print a progress line every N steps")
-      ->check(CLI::NonNegativeNumber);
+      ->transform(levelset::cli::non_negative_int());
   add_common_options(evolve_cmd, threads, evolve.stats);
 
   const std::vector<levelset::cli::Command> registered = levelset::cli::registered_commands(app, threads);

@@ -13,6 +13,7 @@
 #include <tbb/parallel_for.h>
 
 #include "core/error.hpp"
+#include "core/text.hpp"
 #include "formula/formula.hpp"
 #include "grid/interpolate.hpp"
 
@@ -78,7 +79,7 @@ CostGrid build_cost_grid(const DenseGrid& grid, const CostField& field, const Ob
     const double bg = obstacles.band->background();
     if (!(std::isfinite(obstacles.clearance) && std::abs(obstacles.clearance) < bg))
       throw Error(ErrorCode::InvalidArgument, "obstacle clearance",
-                  "clearance must be finite and within the band's background distance " + std::to_string(bg));
+                  "clearance must be finite and within the band's background distance " + format_number(bg));
   }
   if (!std::isfinite(field.uniform) || !(field.uniform > 0.0))
     throw Error(ErrorCode::InvalidArgument, "uniform cost", "must be finite and > 0");

@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "core/error.hpp"
+#include "core/text.hpp"
 #include "distance/redistance.hpp"
 
 namespace levelset::apps {
@@ -15,7 +16,7 @@ OffsetResult offset_surface(const NarrowBand& band, const OffsetOptions& options
     throw Error(ErrorCode::InvalidArgument, "offset distance", "must be finite and non-zero");
   if (!(options.max_distance_voxels > 0) || std::abs(D) / band.voxel_size() > options.max_distance_voxels)
     throw Error(ErrorCode::InvalidArgument, "offset distance",
-                "|D| / h exceeds max_distance_voxels (" + std::to_string(options.max_distance_voxels) + ")");
+                "|D| / h exceeds max_distance_voxels (" + format_number(options.max_distance_voxels) + ")");
   evolve::EvolutionOptions eo;
   eo.speed = evolve::constant_speed(D > 0 ? 1.0 : -1.0);
   eo.scheme = options.scheme;

@@ -9,6 +9,7 @@
 #include <limits>
 
 #include "core/error.hpp"
+#include "core/text.hpp"
 #include "grid/build_from_sdf.hpp"
 #include "grid/interpolate.hpp"
 #include "surface/marching_cubes.hpp"
@@ -47,10 +48,13 @@ struct VolumeArea {
 VolumeArea measure_front(const NarrowBand& band) {
   const SurfaceResult s = marching_cubes(band);
   VolumeArea m;
+  // About the mesh's centre, as measure_mesh does (precision far from the world origin).
+  const BBox box = s.mesh.bounds();
+  const Vec3d o = box.empty() ? Vec3d{} : 0.5 * (box.min + box.max);
   for (const auto& t : s.mesh.triangles) {
-    const Vec3d& a = s.mesh.vertices[t[0]];
-    const Vec3d& b = s.mesh.vertices[t[1]];
-    const Vec3d& c = s.mesh.vertices[t[2]];
+    const Vec3d a = s.mesh.vertices[t[0]] - o;
+    const Vec3d b = s.mesh.vertices[t[1]] - o;
+    const Vec3d c = s.mesh.vertices[t[2]] - o;
     m.volume += dot(a, cross(b, c)) / 6.0;
     m.area += 0.5 * length(cross(b - a, c - a));
   }
@@ -93,7 +97,7 @@ SegmentationResult segment_image(const ImageVolume& image, const SegmentationOpt
   const double cells = (extent.x / h + 1) * (extent.y / h + 1) * (extent.z / h + 1);
   if (!(cells <= double(o.max_grid_voxels)))
     throw Error(ErrorCode::LimitExceeded, "segment_image",
-                "the image box holds " + std::to_string(cells) + " grid voxels of size " + std::to_string(h) +
+                "the image box holds " + format_number(cells) + " grid voxels of size " + format_number(h) +
                     ", above the limit of " + std::to_string(o.max_grid_voxels));
   const double default_radius = o.seed_radius > 0 ? o.seed_radius : 3 * h;
   std::vector<SegmentationSeed> seeds = o.seeds;
@@ -101,7 +105,7 @@ SegmentationResult segment_image(const ImageVolume& image, const SegmentationOpt
   for (SegmentationSeed& s : seeds) {
     require(isfinite(s.center) && std::isfinite(s.radius) && s.radius >= 0, "seed centres and radii must be finite");
     if (s.radius == 0) s.radius = default_radius;
-    require(s.radius >= h, "a seed radius must be at least one grid voxel (" + std::to_string(h) + ")");
+    require(s.radius >= h, "a seed radius must be at least one grid voxel (" + format_number(h) + ")");
     require(s.center.x >= box.min.x && s.center.y >= box.min.y && s.center.z >= box.min.z &&
                 s.center.x <= box.max.x && s.center.y <= box.max.y && s.center.z <= box.max.z,
             "a seed centre lies outside the image");

@@ -45,7 +45,10 @@ bool parse_number(std::string_view s, double& out) {
 
 class Parser {
  public:
-  Parser(std::string_view text, const ParseOptions& options) : text_(text), options_(options) {}
+  // A UTF-8 byte order mark (editors on Windows write one) is skipped; lines and columns count
+  // from after it.
+  Parser(std::string_view text, const ParseOptions& options)
+      : text_(text.substr(0, 3) == "\xEF\xBB\xBF" ? text.substr(3) : text), options_(options) {}
 
   Set parse_root() {
     if (text_.size() > options_.limits.max_bytes)
@@ -106,7 +109,7 @@ class Parser {
     const std::size_t start = pos_;
     std::size_t end = start;
     while (end < text_.size() && text_[end] != '\n' && !(text_[end] == '/' && end + 1 < text_.size() && text_[end + 1] == '/') &&
-           text_[end] != '}')
+           text_[end] != '}' && !((text_[end] == ' ' || text_[end] == '\t') && entry_follows(end)))
       ++end;
     std::string_view raw = text_.substr(start, end - start);
     while (!raw.empty() && std::isspace(static_cast<unsigned char>(raw.back()))) raw.remove_suffix(1);
@@ -156,9 +159,25 @@ class Parser {
       }
     }
   }
-  // After a value: only spaces, a comment, the end of the line or a closing '}'.
+  // Whether the blanks at `at` are followed by the next entry on the same line: a key, then '='
+  // (not '==') or '{'. Entries may share a line (`raster { resolution = 128  band = 3 }`, as
+  // the thesis's format allows); formulas never contain a lone '=', so they are not cut.
+  bool entry_follows(std::size_t at) const {
+    while (at < text_.size() && (text_[at] == ' ' || text_[at] == '\t')) ++at;
+    if (at >= text_.size() || !is_key_start(text_[at])) return false;
+    while (at < text_.size() && is_key_char(text_[at])) ++at;
+    while (at < text_.size() && (text_[at] == ' ' || text_[at] == '\t')) ++at;
+    if (at >= text_.size()) return false;
+    if (text_[at] == '{') return true;
+    return text_[at] == '=' && (at + 1 >= text_.size() || text_[at + 1] != '=');
+  }
+
+  // After a value: only spaces, a comment, the end of the line, a closing '}' or (after a
+  // blank) the next entry.
   void end_of_value() {
+    const std::size_t value_end = pos_;
     skip_spaces();
+    if (pos_ > value_end && entry_follows(value_end)) return;
     if (pos_ < text_.size() && text_[pos_] != '\n' && text_[pos_] != '}' && !starts_comment())
       fail("unexpected " + quote_character(text_, pos_).text + " after the value");
   }

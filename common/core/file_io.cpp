@@ -75,14 +75,28 @@ extern "C" void remove_temps_and_reraise(int sig) {
   std::raise(sig);
 }
 
+}  // namespace
+bool is_stdout(const fs::path& path);
+namespace {
+
 // The destination's kind, checked before anything is written. Returns true when the path is
 // an allowed special file to be written in place.
 bool check_destination(const fs::path& path) {
   struct stat st{};
   if (::lstat(path.c_str(), &st) != 0) return false;  // does not exist (or cannot be seen): created
-  if (S_ISLNK(st.st_mode))
+  if (S_ISLNK(st.st_mode)) {
+    // /dev/stdout and /proc/self/fd/N are links to a terminal, pipe or socket: with special
+    // outputs allowed, such a link is written through in place. A link to anything else (a
+    // regular file, a directory, nothing) is never followed nor replaced.
+    struct stat target{};
+    if (g_allow_special.load() && ::stat(path.c_str(), &target) == 0 &&
+        (S_ISCHR(target.st_mode) || S_ISFIFO(target.st_mode) || S_ISSOCK(target.st_mode) || is_stdout(path)))
+      return true;
     throw Error(ErrorCode::IoError, path.string(),
-                "is a symbolic link; refusing to replace it (write to its target's path instead)");
+                "is a symbolic link; refusing to replace it (write to its target's path instead; a link to a "
+                "device, FIFO or stdout is written through only when special outputs are allowed: "
+                "levelsetd --allow-special-outputs)");
+  }
   if (S_ISREG(st.st_mode)) {
     if (g_guard.load()) {
       Seen& s = seen();
@@ -101,7 +115,8 @@ bool check_destination(const fs::path& path) {
                   (S_ISDIR(st.st_mode) ? "a directory" : S_ISCHR(st.st_mode) || S_ISBLK(st.st_mode) ? "a device"
                                                       : S_ISFIFO(st.st_mode)                            ? "a FIFO"
                                                                                                         : "a special file") +
-                  "); refusing to replace it");
+                  "); refusing to replace it (a device or FIFO is written in place only when special "
+                  "outputs are allowed: levelsetd --allow-special-outputs)");
 }
 
 void write_all(int fd, const fs::path& path, std::string_view bytes, const char* cleanup) {
@@ -120,6 +135,11 @@ void write_all(int fd, const fs::path& path, std::string_view bytes, const char*
 }
 
 }  // namespace
+
+bool is_stdout(const fs::path& path) {
+  struct stat a{}, b{};
+  return ::fstat(1, &b) == 0 && ::stat(path.c_str(), &a) == 0 && a.st_dev == b.st_dev && a.st_ino == b.st_ino;
+}
 
 void allow_special_outputs(bool on) { g_allow_special.store(on); }
 void enable_output_guard(bool on) { g_guard.store(on); }
@@ -154,8 +174,10 @@ std::string read_file_bytes(const fs::path& path, std::uint64_t max_bytes) {
 
 void write_file_atomically(const fs::path& path, std::string_view bytes) {
   if (check_destination(path)) {
-    // An allowed character device or FIFO: written in place, nothing to rename.
-    const int fd = ::open(path.c_str(), O_WRONLY | O_CLOEXEC | O_NOFOLLOW);
+    // An allowed character device or FIFO (or a link to one, checked above): in place.
+    // O_APPEND: /dev/stdout redirected to a regular file writes after what is there (nothing
+    // after '>', the earlier output after '>>'), never over it.
+    const int fd = ::open(path.c_str(), O_WRONLY | O_APPEND | O_CLOEXEC);
     if (fd < 0) throw Error(ErrorCode::IoError, path.string(), std::string("cannot open: ") + std::strerror(errno));
     write_all(fd, path, bytes, nullptr);
     ::close(fd);

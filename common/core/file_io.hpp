@@ -8,7 +8,7 @@
 // Outputs never clobber (issue 14): a destination that exists and is a symbolic link, or is
 // not a regular file (a device such as /dev/null, a FIFO, a directory), is refused before
 // anything is written, unless allow_special_outputs(true) lets a character device or FIFO be
-// written in place (no temp file, no rename). With the output guard on (the batch CLI turns it
+// written in place (no temp file, no rename), also through a link that leads to one or to this process's stdout (/dev/stdout), appending. With the output guard on (the batch CLI turns it
 // on; off by default, so a long-running daemon keeps no list), every file read through
 // read_file_bytes and every file written is remembered, and a write over one of them (an input
 // of this run, or an output it already wrote) is refused. A temp file is removed on every
@@ -27,6 +27,9 @@ std::string read_file_bytes(const std::filesystem::path& path,
                             std::uint64_t max_bytes = std::uint64_t{1} << 34);
 
 void write_file_atomically(const std::filesystem::path& path, std::string_view bytes);
+
+// True when path (following links) is the same file as this process's stdout (fd 1).
+bool is_stdout(const std::filesystem::path& path);
 
 // Process-wide switches (see above); thread-safe.
 void allow_special_outputs(bool on);

@@ -9,6 +9,7 @@
 #include <tbb/parallel_for.h>
 
 #include "core/error.hpp"
+#include "core/text.hpp"
 #include "distance/brick_triangle_lists.hpp"
 #include "distance/inside_masks.hpp"
 #include "distance/orient_faces.hpp"
@@ -42,8 +43,8 @@ void check_budget(const TriangleMesh& mesh, const CptOptions& options) {
   for (int a = 0; a < 3; ++a) voxels *= std::ceil((box.max[a] - box.min[a]) / h) + pad;
   if (!(voxels <= double(options.max_domain_voxels)))
     throw Error(ErrorCode::LimitExceeded, "mesh",
-                "the mesh spans " + std::to_string(voxels) + " voxels at voxel size " +
-                    std::to_string(h) + ", more than the voxel budget of " +
+                "the mesh spans " + format_number(voxels) + " voxels at voxel size " +
+                    format_number(h) + ", more than the voxel budget of " +
                     std::to_string(options.max_domain_voxels) + "; increase the voxel size");
 }
 

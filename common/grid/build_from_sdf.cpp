@@ -8,6 +8,7 @@
 #include <tbb/parallel_for.h>
 
 #include "core/error.hpp"
+#include "core/text.hpp"
 #include "grid/band_builder.hpp"
 
 namespace levelset {
@@ -99,7 +100,7 @@ SdfBuildResult build_from_sdf(const SdfFunction& sdf, const BBox& surface_bounds
   }
   if (domain > double(options.max_domain_voxels))
     throw Error(ErrorCode::LimitExceeded, "voxel_size",
-                "domain of " + std::to_string(domain) + " voxels exceeds the budget of " +
+                "domain of " + format_number(domain) + " voxels exceeds the budget of " +
                     std::to_string(options.max_domain_voxels) + "; increase the voxel size");
 
   BlockSearch search{sdf, frame_band, band_world, {}, 0};

@@ -9,6 +9,7 @@
 #include <zstd.h>
 
 #include "core/error.hpp"
+#include "core/file_extension.hpp"
 #include "core/file_io.hpp"
 
 namespace levelset {
@@ -178,6 +179,7 @@ std::string encode_lsg(const NarrowBand& band, const LsgWriteOptions& options) {
 
 LsgWriteResult save_lsg(const NarrowBand& band, const std::filesystem::path& path,
                         const LsgWriteOptions& options) {
+  require_extension(path, kLsgExtensions, "a narrow band");
   const std::string bytes = encode_lsg(band, options);
   write_file_atomically(path, bytes);
   return {bytes.size(), raw_size(band.brick_count(), band.active_voxel_count(), !options.closest_points.empty())};

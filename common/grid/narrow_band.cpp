@@ -7,6 +7,7 @@
 #include <string>
 
 #include "core/error.hpp"
+#include "core/text.hpp"
 
 namespace levelset {
 
@@ -15,11 +16,11 @@ namespace {
 void validate_frame(const GridFrame& f) {
   if (!(std::isfinite(f.voxel_size) && f.voxel_size > 0))
     throw Error(ErrorCode::InvalidArgument, "voxel_size",
-                "must be finite and > 0, got " + std::to_string(f.voxel_size));
+                "must be finite and > 0, got " + format_number(f.voxel_size));
   if (!isfinite(f.origin)) throw Error(ErrorCode::InvalidArgument, "origin", "must be finite");
   if (!(std::isfinite(f.half_width) && f.half_width >= 1.0 && f.half_width <= 1024.0))
     throw Error(ErrorCode::InvalidArgument, "half_width",
-                "band half-width must be in [1, 1024] voxels, got " + std::to_string(f.half_width));
+                "band half-width must be in [1, 1024] voxels, got " + format_number(f.half_width));
   const double bg = f.half_width * f.voxel_size;
   if (!(bg < 1e30))
     throw Error(ErrorCode::InvalidArgument, "voxel_size", "band width overflows float");

@@ -6,6 +6,7 @@
 #include <string>
 
 #include "core/error.hpp"
+#include "core/file_extension.hpp"
 #include "core/file_io.hpp"
 
 namespace levelset {
@@ -42,9 +43,11 @@ std::string encode_nrrd(const NrrdFrame& frame, std::span<const float> samples) 
   return encode(frame, samples, "float");
 }
 void save_nrrd(const std::filesystem::path& path, const NrrdFrame& frame, std::span<const std::int32_t> samples) {
+  require_extension(path, kNrrdOutputExtensions, "an NRRD image");
   write_file_atomically(path, encode_nrrd(frame, samples));
 }
 void save_nrrd(const std::filesystem::path& path, const NrrdFrame& frame, std::span<const float> samples) {
+  require_extension(path, kNrrdOutputExtensions, "an NRRD image");
   write_file_atomically(path, encode_nrrd(frame, samples));
 }
 

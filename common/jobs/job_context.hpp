@@ -92,6 +92,11 @@ class JobContext {
   MeshMeasures measure_band(const NarrowBand& band) const;
   std::string output_path(std::string_view file_name) const;  // OUTDIR/file_name
 
+  // Before any work (run_job calls it): the output section's values are valid, and no file the
+  // job names is one this job could write (OUTDIR/STEM*.lsg|.ply|...|.log|.json, compared by
+  // directory identity): Error{InvalidArgument | IoError} at the entry's place.
+  void check_outputs() const;
+
   void log(const std::string& line) const;
   nlohmann::json& stats() { return stats_; }
   const std::vector<std::string>& outputs() const { return outputs_; }

@@ -6,6 +6,8 @@
 #include <mutex>
 
 #include "core/error.hpp"
+#include "core/text.hpp"
+#include "core/file_io.hpp"
 #include "core/suggest.hpp"
 #include "jobs/applications.hpp"
 #include "jobs/job.hpp"
@@ -53,13 +55,17 @@ JobResult run_job(const config::Set& job, const JobOptions& options_in) {
                     (best.empty() ? "" : " (did you mean '" + best + "'?)") + "; known: " + known);
   }
   config::check_keys(job, {"job", "input", "raster", "output", std::string(app->name)}, options_in.name);
+  JobContext(job, options_in).check_outputs();
 
   std::error_code ec;
   fs::create_directories(options_in.output_dir, ec);
   if (ec) throw Error(ErrorCode::IoError, options_in.output_dir, "cannot create the output directory: " + ec.message());
 
-  // The log goes to OUTDIR/STEM.log and to the caller's sink, each line once.
+  // The log goes to OUTDIR/STEM.log and to the caller's sink, each line once. Its path and the
+  // stats' pass the same destination checks as every other output before anything is written.
   const std::string log_path = (fs::path(options_in.output_dir) / (stem(options_in.name) + ".log")).string();
+  const std::string stats_path = (fs::path(options_in.output_dir) / (stem(options_in.name) + ".stats.json")).string();
+  check_output_paths({}, {log_path, stats_path});
   auto log_file = std::make_shared<std::ofstream>(log_path, std::ios::trunc);
   if (!*log_file) throw Error(ErrorCode::IoError, log_path, "cannot write the log");
   auto log_mutex = std::make_shared<std::mutex>();
@@ -84,23 +90,20 @@ JobResult run_job(const config::Set& job, const JobOptions& options_in) {
     throw Error(e.code(), options_in.name + " (" + std::string(app->name) + ": " + e.where() + ")", e.reason());
   }
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  context.log("done in " + std::to_string(seconds) + " s");
+  context.log("done in " + format_number(seconds) + " s");
 
   JobResult result;
   result.application = std::string(app->name);
   result.seconds = seconds;
   result.outputs = context.outputs();
   result.outputs.push_back(log_path);
-  const std::string stats_path = (fs::path(options.output_dir) / (stem(options.name) + ".stats.json")).string();
   result.outputs.push_back(stats_path);
   result.stats = context.stats();
   result.stats["job"] = result.application;
   result.stats["name"] = options.name;
   result.stats["seconds"]["total"] = seconds;
   result.stats["outputs"] = result.outputs;
-  std::ofstream stats_file(stats_path, std::ios::trunc);
-  stats_file << result.stats.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) << '\n';
-  if (!stats_file) throw Error(ErrorCode::IoError, stats_path, "cannot write the stats");
+  write_file_atomically(stats_path, result.stats.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n");
   return result;
 }
 

@@ -66,12 +66,16 @@ MeshMeasures measure_mesh(const TriangleMesh& mesh) {
   std::vector<DirectedEdge> edges;
   edges.reserve(3 * m.faces);
   double min_angle = 180.0, sum_min_angle = 0.0, max_aspect = 0.0;
+  // The signed tetrahedron volumes are taken about the mesh's centre, not the world origin: far
+  // from the origin (a unit cube at 5e6) the products of large coordinates cancel catastrophically.
+  const BBox box = mesh.bounds();
+  const Vec3d origin = box.empty() ? Vec3d{} : 0.5 * (box.min + box.max);
   for (const auto& t : mesh.triangles) {
     const Vec3d &a = mesh.vertices[t[0]], &b = mesh.vertices[t[1]], &c = mesh.vertices[t[2]];
     const Vec3d n = cross(b - a, c - a);
     const double area2 = length(n);
     m.area += 0.5 * area2;
-    m.volume += dot(a, cross(b, c)) / 6.0;
+    m.volume += dot(a - origin, cross(b - origin, c - origin)) / 6.0;
     for (int k = 0; k < 3; ++k) {
       referenced[t[k]] = true;
       const std::uint32_t u = t[k], v = t[(k + 1) % 3];

@@ -7,6 +7,8 @@
 
 #include "apps/csg.hpp"
 #include "apps/shape_measures.hpp"
+#include "commands/number_checks.hpp"
+#include "commands/output_check.hpp"
 #include "commands/command.hpp"
 #include "commands/report.hpp"
 #include "commands/shape_report.hpp"
@@ -67,15 +69,15 @@ Command add_csg_command(CLI::App& app, int& threads) {
       ->check(CLI::IsMember({"union", "intersection", "difference"}));
   sub->add_option("a", args->a, "First .lsg (A)")->required();
   sub->add_option("b", args->b, "Second .lsg (B)")->required();
-  sub->add_option("-o,--output", args->output, "Output .lsg file")->required();
-  sub->add_option("--voxel-size", args->voxel_size, "Result voxel size (default: the finer input's)")->check(CLI::PositiveNumber);
+  sub->add_option("-o,--output", args->output, "Output .lsg file")->required()->check(lsg_output());
+  sub->add_option("--voxel-size", args->voxel_size, "Result voxel size (default: the finer input's)")->transform(levelset::cli::positive());
   sub->add_option("--band", args->half_width, "Result half-width in voxels (default: the larger input's)")
-      ->check(CLI::Range(2.0, 1024.0));
+      ->transform(levelset::cli::in_range(2.0, 1024.0));
   auto* fair = sub->add_option("--fair-seams", args->seam_time, "Fair the seam with mean curvature flow for TIME (world units^2)")
-                   ->check(CLI::PositiveNumber);
+                   ->transform(levelset::cli::positive());
   auto* radius = sub->add_option("--seam-radius", args->seam_radius,
                                  "Region of influence R (world units): full speed where |a|, |b| <= R, none beyond 2R")
-                     ->check(CLI::PositiveNumber);
+                     ->transform(levelset::cli::positive());
   fair->needs(radius);
   add_common_options(sub, threads, args->stats);
   return {sub, [args]() { return run_csg(*args); }};

@@ -6,6 +6,8 @@
 #include <string>
 
 #include "apps/fairing.hpp"
+#include "commands/number_checks.hpp"
+#include "commands/output_check.hpp"
 #include "commands/command.hpp"
 #include "commands/report.hpp"
 #include "commands/shape_report.hpp"
@@ -64,14 +66,14 @@ Command add_fair_command(CLI::App& app, int& threads) {
   auto args = std::make_shared<FairArgs>();
   CLI::App* sub = app.add_subcommand("fair", "Fairing: smooth the surface with a curvature flow, report roughness");
   sub->add_option("input", args->input, "Input .lsg")->required();
-  sub->add_option("-o,--output", args->output, "Output .lsg file")->required();
+  sub->add_option("-o,--output", args->output, "Output .lsg file")->required()->check(lsg_output());
   sub->add_option("--flow", args->flow, "mean-curvature (default), mean-gaussian, volume-preserving")
       ->check(CLI::IsMember({"mean-curvature", "mean-gaussian", "volume-preserving"}));
-  auto* time_opt = sub->add_option("--time", args->time, "Evolve until this time (world units^2)")->check(CLI::PositiveNumber);
-  auto* steps_opt = sub->add_option("--steps", args->steps, "Number of time steps")->check(CLI::PositiveNumber);
+  auto* time_opt = sub->add_option("--time", args->time, "Evolve until this time (world units^2)")->transform(levelset::cli::positive());
+  auto* steps_opt = sub->add_option("--steps", args->steps, "Number of time steps")->transform(levelset::cli::positive_int());
   time_opt->excludes(steps_opt);
   sub->add_option("--redistance-every", args->redistance_every, "Redistance every K steps (0: never)")
-      ->check(CLI::NonNegativeNumber);
+      ->transform(levelset::cli::non_negative_int());
   add_common_options(sub, threads, args->stats);
   return {sub, [args]() { return run_fair(*args); }};
 }

@@ -45,7 +45,7 @@ int run_measure(const MeasureArgs& args) {
   std::printf("mesh:            %llu vertices, %llu triangles, %s\n", (unsigned long long)m.vertices,
               (unsigned long long)m.faces, m.watertight && m.manifold ? "watertight and manifold" : "open or non-manifold");
   if (!m.bounds.empty())
-    std::printf("bounds:          (%.6g, %.6g, %.6g) - (%.6g, %.6g, %.6g)\n", m.bounds.min.x, m.bounds.min.y,
+    std::printf("bounds:          (%.10g, %.10g, %.10g) - (%.10g, %.10g, %.10g)\n", m.bounds.min.x, m.bounds.min.y,
                 m.bounds.min.z, m.bounds.max.x, m.bounds.max.y, m.bounds.max.z);
   return 0;
 }

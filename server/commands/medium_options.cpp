@@ -1,3 +1,4 @@
+#include "commands/number_checks.hpp"
 #include "commands/medium_options.hpp"
 
 #include <chrono>
@@ -53,8 +54,8 @@ void add_medium_options(CLI::App* sub, MediumArgs& a) {
                   "Cost per node as a NRRD volume (fixes the grid; +inf = blocked)");
   sub->add_option("--bounds", a.bounds, "Grid box xmin,ymin,zmin,xmax,ymax,zmax (default: the points and obstacles, padded)");
   auto* res = sub->add_option("--resolution,-r", a.resolution, "Voxels along the longest side of the box (default 128)")
-                  ->check(CLI::Range(2, 1 << 15));
-  auto* vs = sub->add_option("--voxel-size", a.voxel_size, "Voxel size in world units")->check(CLI::PositiveNumber);
+                  ->transform(levelset::cli::in_range(2, 1 << 15));
+  auto* vs = sub->add_option("--voxel-size", a.voxel_size, "Voxel size in world units")->transform(levelset::cli::positive());
   res->excludes(vs);
   sub->add_option("--order", a.order, "Fast marching order: 1 or 2 (default)")->check(CLI::IsMember({1, 2}));
 }

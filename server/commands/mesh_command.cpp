@@ -7,12 +7,14 @@
 #include "grid/lsg_file.hpp"
 #include "io/mesh_writer.hpp"
 #include "surface/marching_cubes.hpp"
+#include "surface/iso_range.hpp"
 #include "surface/mesh_measures.hpp"
 #include "surface/surface_nets.hpp"
 
 namespace levelset::cli {
 
 SurfaceResult extract_surface(const NarrowBand& band, const std::string& method, double iso) {
+  check_iso_in_band(band, iso, "--iso");
   if (method == "nets") {
     SurfaceNetsOptions options;
     options.iso = iso;

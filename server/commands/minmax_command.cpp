@@ -6,6 +6,8 @@
 #include <string>
 
 #include "apps/minmax_flow.hpp"
+#include "commands/number_checks.hpp"
+#include "commands/output_check.hpp"
 #include "commands/command.hpp"
 #include "commands/report.hpp"
 #include "commands/shape_report.hpp"
@@ -68,14 +70,14 @@ Command add_minmax_command(CLI::App& app, int& threads) {
   auto args = std::make_shared<MinMaxArgs>();
   CLI::App* sub = app.add_subcommand("minmax", "Min/max flow: remove oscillations below a scale, keep features, stop at steady state");
   sub->add_option("input", args->input, "Input .lsg")->required();
-  sub->add_option("-o,--output", args->output, "Output .lsg file")->required();
+  sub->add_option("-o,--output", args->output, "Output .lsg file")->required()->check(lsg_output());
   sub->add_option("--radius", args->radius, "Scale R in voxels (the average's cube has 2R+1 voxels a side)")
       ->required()
-      ->check(CLI::Range(1, 16));
+      ->transform(levelset::cli::in_range(1, 16));
   sub->add_option("--tolerance", args->tolerance, "Steady when the mean change near the surface < TOL voxels per step")
-      ->check(CLI::PositiveNumber);
-  sub->add_option("--max-steps", args->max_steps, "Give up after N steps")->check(CLI::PositiveNumber);
-  sub->add_option("--update-every", args->update_every, "Recompute the average every K steps")->check(CLI::PositiveNumber);
+      ->transform(levelset::cli::positive());
+  sub->add_option("--max-steps", args->max_steps, "Give up after N steps")->transform(levelset::cli::positive_int());
+  sub->add_option("--update-every", args->update_every, "Recompute the average every K steps")->transform(levelset::cli::positive_int());
   add_common_options(sub, threads, args->stats);
   return {sub, [args]() { return run_minmax(*args); }};
 }

@@ -7,6 +7,7 @@
 
 #include "apps/offset.hpp"
 #include "apps/shape_measures.hpp"
+#include "commands/output_check.hpp"
 #include "commands/command.hpp"
 #include "commands/report.hpp"
 #include "commands/shape_report.hpp"
@@ -76,7 +77,7 @@ Command add_offset_command(CLI::App& app, int& threads) {
   auto args = std::make_shared<OffsetArgs>();
   CLI::App* sub = app.add_subcommand("offset", "Offset surface: move the surface by a signed distance D along its normals");
   sub->add_option("input", args->input, "Input .lsg")->required();
-  sub->add_option("-o,--output", args->output, "Output .lsg file")->required();
+  sub->add_option("-o,--output", args->output, "Output .lsg file")->required()->check(lsg_output());
   sub->add_option("--distance", args->distance, "Signed distance D in world units (> 0 grows, < 0 shrinks)")->required();
   sub->add_option("--scheme", args->scheme, "Spatial scheme: weno5 (default), eno2, godunov")
       ->check(CLI::IsMember({"weno5", "eno2", "godunov"}));

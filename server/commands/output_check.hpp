@@ -10,4 +10,10 @@ namespace levelset::cli {
 
 void check_command_files(const CLI::App& sub);
 
+// Validators for output options, run while the command line is parsed (before any work): the
+// value's extension must name the format the option writes (core/file_extension.hpp).
+CLI::Validator lsg_output();   // .lsg
+CLI::Validator mesh_output();  // .off .obj .ply .stl .tria
+CLI::Validator nrrd_output();  // .nrrd
+
 }  // namespace levelset::cli

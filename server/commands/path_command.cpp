@@ -8,6 +8,7 @@
 #include <string>
 
 #include "apps/path_planning.hpp"
+#include "commands/number_checks.hpp"
 #include "commands/command.hpp"
 #include "commands/medium_options.hpp"
 #include "commands/report.hpp"
@@ -97,7 +98,7 @@ Command add_path_command(CLI::App& app, int& threads) {
   sub->add_option("--from", args->from, "Start point x,y,z")->required();
   sub->add_option("--to", args->to, "Goal point x,y,z")->required();
   add_medium_options(sub, args->medium);
-  sub->add_option("--step", args->step, "Trace step in voxels (default 0.5)")->check(CLI::Range(0.01, 1.0));
+  sub->add_option("--step", args->step, "Trace step in voxels (default 0.5)")->transform(levelset::cli::in_range(0.01, 1.0));
   sub->add_option("--rk", args->rk, "Trace integrator: 2 (Heun, default) or 4")->check(CLI::IsMember({2, 4}));
   sub->add_option("-o,--output", args->output, "Output polyline (text: one 'x y z' per line)")->required();
   add_common_options(sub, threads, args->stats);

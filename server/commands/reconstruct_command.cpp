@@ -9,6 +9,8 @@
 
 #include "apps/reconstruction.hpp"
 #include "apps/sample_points.hpp"
+#include "commands/number_checks.hpp"
+#include "commands/output_check.hpp"
 #include "commands/command.hpp"
 #include "commands/report.hpp"
 #include "core/error.hpp"
@@ -98,11 +100,11 @@ Command add_reconstruct_command(CLI::App& app, int& threads) {
   CLI::App* sub = app.add_subcommand("reconstruct", "Surface from an unorganised point cloud (no normals needed)");
   sub->add_option("points", args->input, "Point cloud (.xyz .xyzn .pwn .ply .off) or builtin:knot[:N]")->required();
   auto* res = sub->add_option("--resolution", args->resolution, "Voxels along the longest side of the padded box (default 256)")
-                  ->check(CLI::Range(16, 1 << 14));
-  auto* vs = sub->add_option("--voxel-size", args->voxel_size, "Final voxel size (world units)")->check(CLI::PositiveNumber);
+                  ->transform(levelset::cli::in_range(16, 1 << 14));
+  auto* vs = sub->add_option("--voxel-size", args->voxel_size, "Final voxel size (world units)")->transform(levelset::cli::positive());
   res->excludes(vs);
-  sub->add_option("-o,--output", args->output, "Output mesh (.ply .obj .off .stl)")->required();
-  sub->add_option("--lsg", args->lsg, "Also write the final narrow band (.lsg)");
+  sub->add_option("-o,--output", args->output, "Output mesh (.ply .obj .off .stl)")->required()->check(mesh_output());
+  sub->add_option("--lsg", args->lsg, "Also write the final narrow band (.lsg)")->check(lsg_output());
   auto& o = args->options;
   sub->add_option("--curvature-weight", o.curvature_weight, "Curvature weight of the coarsest level's flow")->capture_default_str();
   sub->add_option("--snap-passes", o.snap_passes, "Snap passes per finer level")->capture_default_str();

@@ -1,10 +1,11 @@
 // The list of self-registering subcommands (command.hpp). One line per subcommand.
+#include "commands/number_checks.hpp"
 #include "commands/command.hpp"
 
 namespace levelset::cli {
 
 void add_common_options(CLI::App* sub, int& threads, std::string& stats) {
-  sub->add_option("--threads", threads, "Worker threads (default: all cores)")->check(CLI::Range(1, 1024));
+  sub->add_option("--threads", threads, "Worker threads (default: all cores)")->transform(levelset::cli::in_range(1, 1024));
   sub->add_option("--stats", stats, "Write timings and sizes as JSON to FILE (or - for stdout)");
 }
 

@@ -49,8 +49,14 @@ void write_stats(const Stats& stats, const std::string& path) {
   }
 }
 
+namespace {
+bool g_output_on_stdout = false;
+}  // namespace
+
+void set_output_on_stdout(bool on) { g_output_on_stdout = on; }
+
 std::FILE* summary_stream(const std::string& stats_path) {
-  return stats_path == "-" ? stderr : stdout;
+  return stats_path == "-" || g_output_on_stdout ? stderr : stdout;
 }
 
 std::string human_bytes(std::uint64_t bytes) {

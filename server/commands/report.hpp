@@ -49,8 +49,10 @@ std::string json_text(const nlohmann::json& j);
 
 std::string human_bytes(std::uint64_t bytes);
 
-// Where the one-line human summary goes: stderr when --stats writes JSON to stdout ("-"),
-// so that stdout stays parseable; stdout otherwise.
+// Where the one-line human summary goes: stderr when --stats writes JSON to stdout ("-") or
+// an output is stdout itself (-o /dev/stdout with --allow-special-outputs), so that stdout
+// stays parseable; stdout otherwise.
 std::FILE* summary_stream(const std::string& stats_path);
+void set_output_on_stdout(bool on);  // check_command_files says so, before the command runs
 
 }  // namespace levelset::cli

@@ -9,6 +9,8 @@
 #include <vector>
 
 #include "apps/segmentation.hpp"
+#include "commands/number_checks.hpp"
+#include "commands/output_check.hpp"
 #include "commands/command.hpp"
 #include "commands/report.hpp"
 #include "core/error.hpp"
@@ -144,22 +146,22 @@ Command add_segment_command(CLI::App& app, int& threads) {
   sub->add_option("image", args->image, "Input image (.inr, .inr.gz, .nrrd, .nhdr)")->required();
   sub->add_option("--seed", args->seeds, "Seed x,y,z[,r] in world coordinates of the image (repeatable)")
       ->required();
-  sub->add_option("--seed-radius", args->seed_radius, "Radius of seeds without one (default 3 grid voxels; keep it above 2 eps or the seed shrinks)")->check(CLI::NonNegativeNumber);
-  sub->add_option("--sigma", args->sigma, "Gaussian smoothing of the image, in image voxels")->check(CLI::Range(0.0, 64.0));
-  sub->add_option("--contrast", args->contrast, "Intensity change per voxel (of the [0,1]-normalised image) where g = 1/2")->check(CLI::PositiveNumber);
+  sub->add_option("--seed-radius", args->seed_radius, "Radius of seeds without one (default 3 grid voxels; keep it above 2 eps or the seed shrinks)")->transform(levelset::cli::non_negative());
+  sub->add_option("--sigma", args->sigma, "Gaussian smoothing of the image, in image voxels")->transform(levelset::cli::in_range(0.0, 64.0));
+  sub->add_option("--contrast", args->contrast, "Intensity change per voxel (of the [0,1]-normalised image) where g = 1/2")->transform(levelset::cli::positive());
   sub->add_option("--power", args->power, "p in g = 1/(1+(|grad|/contrast)^p): 1 or 2")->check(CLI::IsMember({1, 2}));
-  sub->add_option("--eps", args->eps, "Curvature weight eps in (1 - eps H) g, world units (default: one grid voxel)")->check(CLI::NonNegativeNumber);
-  sub->add_option("--attraction", args->attraction, "Weight of the edge attraction -grad g (0: the thesis's plain model)")->check(CLI::NonNegativeNumber);
-  sub->add_option("--voxel-size", args->voxel_size, "Grid spacing (default: the image's smallest spacing)")->check(CLI::NonNegativeNumber);
-  sub->add_option("--band", args->band, "Band half-width in voxels")->check(CLI::Range(2.0, 64.0));
-  auto* steps = sub->add_option("--steps", args->steps, "Run exactly N steps")->check(CLI::PositiveNumber);
-  auto* time = sub->add_option("--time", args->time, "Run until time T (the front moves at speed g <= 1 world unit per time)")->check(CLI::PositiveNumber);
+  sub->add_option("--eps", args->eps, "Curvature weight eps in (1 - eps H) g, world units (default: one grid voxel)")->transform(levelset::cli::non_negative());
+  sub->add_option("--attraction", args->attraction, "Weight of the edge attraction -grad g (0: the thesis's plain model)")->transform(levelset::cli::non_negative());
+  sub->add_option("--voxel-size", args->voxel_size, "Grid spacing (default: the image's smallest spacing)")->transform(levelset::cli::non_negative());
+  sub->add_option("--band", args->band, "Band half-width in voxels")->transform(levelset::cli::in_range(2.0, 64.0));
+  auto* steps = sub->add_option("--steps", args->steps, "Run exactly N steps")->transform(levelset::cli::positive_int());
+  auto* time = sub->add_option("--time", args->time, "Run until time T (the front moves at speed g <= 1 world unit per time)")->transform(levelset::cli::positive());
   steps->excludes(time);
-  sub->add_option("--max-time", args->max_time, "Cap for the run until steady (default: twice the image diagonal)")->check(CLI::NonNegativeNumber);
-  sub->add_option("--tolerance", args->tolerance, "Steady when the front moved less than this many voxels (mean) since the last check")->check(CLI::NonNegativeNumber);
-  sub->add_option("-o,--output", args->output, "Output .lsg")->required();
-  sub->add_option("--mesh", args->mesh, "Also write the surface (.ply .off .obj .stl)");
-  sub->add_option("--mask", args->mask, "Also write the inside voxels of the image as a uint8 .nrrd");
+  sub->add_option("--max-time", args->max_time, "Cap for the run until steady (default: twice the image diagonal)")->transform(levelset::cli::non_negative());
+  sub->add_option("--tolerance", args->tolerance, "Steady when the front moved less than this many voxels (mean) since the last check")->transform(levelset::cli::non_negative());
+  sub->add_option("-o,--output", args->output, "Output .lsg")->required()->check(lsg_output());
+  sub->add_option("--mesh", args->mesh, "Also write the surface (.ply .off .obj .stl)")->check(mesh_output());
+  sub->add_option("--mask", args->mask, "Also write the inside voxels of the image as a uint8 .nrrd")->check(nrrd_output());
   sub->add_flag("--report", args->report, "Print one line per steady-state check");
   add_common_options(sub, threads, args->stats);
   return {sub, [args] { return run_segment(*args); }};

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "apps/voronoi.hpp"
+#include "commands/output_check.hpp"
 #include "commands/command.hpp"
 #include "commands/medium_options.hpp"
 #include "commands/report.hpp"
@@ -108,8 +109,8 @@ Command add_voronoi_command(CLI::App& app, int& threads) {
       ->required()
       ->take_all();
   add_medium_options(sub, args->medium);
-  sub->add_option("-o,--output", args->output, "Output labels (.nrrd, int32, -1 = blocked/unreached)")->required();
-  sub->add_option("--distance", args->distance, "Also write the travel time to the nearest seed (.nrrd, float32)");
+  sub->add_option("-o,--output", args->output, "Output labels (.nrrd, int32, -1 = blocked/unreached)")->required()->check(nrrd_output());
+  sub->add_option("--distance", args->distance, "Also write the travel time to the nearest seed (.nrrd, float32)")->check(nrrd_output());
   add_common_options(sub, threads, args->stats);
   return {sub, [args] { return run_voronoi(*args); }};
 }

@@ -115,6 +115,42 @@ TEST(ConfigFile, StringsCommentsAndSetsOnOneLine) {
   EXPECT_TRUE(parse_config("// only a comment\n\n").entries.empty());
 }
 
+TEST(ConfigFile, EntriesShareALineSeparatedByBlanks) {
+  // The README's example (issue 14: refused before), and every value kind followed by another
+  // entry on its line.
+  const Set root = parse_config(
+      "raster { resolution = 128  band = 3 }\n"
+      "output { mesh = ply  lsg = yes  method = mc }\n"
+      "a = \"s\" b = (1, 2) c = word d { e = 1 } f = 2\n"
+      "pde { formula = -(k1+k2) * 0.5  eps = 0.1 }\n"
+      "g = x == y\n");
+  const Set& raster = root.find("raster")->set;
+  EXPECT_EQ(raster.find("resolution")->value.number, 128);
+  EXPECT_EQ(raster.find("band")->value.number, 3);
+  EXPECT_EQ(root.find("output")->set.find("method")->value.text, "mc");
+  EXPECT_EQ(root.find("a")->value.text, "s");
+  EXPECT_EQ(root.find("b")->value.tuple, (std::vector<double>{1, 2}));
+  EXPECT_EQ(root.find("c")->value.kind, Value::Kind::Word);
+  EXPECT_EQ(root.find("d")->set.find("e")->value.number, 1);
+  EXPECT_EQ(root.find("f")->value.number, 2);
+  // A formula keeps its blanks and operators; only "KEY =" after a blank starts an entry, and
+  // '==' does not.
+  EXPECT_EQ(root.find("pde")->set.find("formula")->value.text, "-(k1+k2) * 0.5");
+  EXPECT_EQ(root.find("pde")->set.find("eps")->value.number, 0.1);
+  EXPECT_EQ(root.find("g")->value.text, "x == y");
+}
+
+TEST(ConfigFile, ByteOrderMarkIsSkipped) {
+  const Set root = parse_config("\xEF\xBB\xBF" "job = offset\nraster { band = 3 }\n");
+  EXPECT_EQ(root.find("job")->value.text, "offset");
+  // Places count from after the mark.
+  const Failure f = parse_failure("\xEF\xBB\xBF" "a = 1\nb 2\n");
+  ASSERT_TRUE(f.thrown);
+  EXPECT_EQ(f.where, "job.conf:2:3");
+  // A mark anywhere else is a character like any other: refused where a key is expected.
+  EXPECT_TRUE(parse_failure("a = 1\n\xEF\xBB\xBF" "b = 2\n").thrown);
+}
+
 TEST(ConfigFile, ErrorsNameLineAndColumn) {
   struct Case {
     const char* text;

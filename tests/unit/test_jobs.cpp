@@ -107,8 +107,9 @@ TEST(Jobs, ErrorsNameThePlaceAndTheReason) {
       {"job = evolv\n", {}, ErrorCode::InvalidArgument, "test.conf:1:1", "did you mean 'evolve'"},
       {"job = evolve\nimput { }\n", {}, ErrorCode::InvalidArgument, "test.conf:2:1", "did you mean 'input'"},
       {"job = evolve\ninput = sphere\n", {}, ErrorCode::InvalidArgument, "test.conf:2:1", "must be a set"},
-      {"job = evolve\ninput { shape = sphere mesh = a.off }\n", {}, ErrorCode::InvalidArgument, "test.conf:2:9",
-       "is not one of"},
+      // Two entries on one line (issue 14): both read, and the pair refused as on two lines.
+      {"job = evolve\ninput { shape = sphere mesh = a.off }\n", {}, ErrorCode::InvalidArgument, "test.conf",
+       "exactly one of"},
       {"job = evolve\ninput { shape = sphere\n mesh = a.off }\n", {}, ErrorCode::InvalidArgument, "test.conf",
        "exactly one of"},
       {"job = evolve\ninput { shape = cube }\n", {}, ErrorCode::InvalidArgument, "test.conf:2:9", "not one of"},
