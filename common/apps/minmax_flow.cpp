@@ -148,6 +148,12 @@ MinMaxResult minmax_flow(const NarrowBand& band, const MinMaxOptions& o) {
     eo.progress = o.progress;
     evolve::EvolutionResult er = evolve::evolve(current, eo);
     evolve::throw_if_stopped(er, "minmax");
+    if (er.stop == evolve::StopReason::Stopped) {
+      current = std::move(er.band);
+      steps += er.steps;
+      time += er.time;
+      break;
+    }
     const Change change = change_near_front(current, er.band);
     steps += er.steps;
     time += er.time;

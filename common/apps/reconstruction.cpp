@@ -698,6 +698,7 @@ ReconstructionResult reconstruct_surface(const std::vector<Vec3d>& input, const 
       ev.steps = 1;
       ev.drift_tolerance = 0.1;  // the speed is constant along normals near the data: rare
       ev.progress.cancel = o.progress.cancel;
+      ev.progress.stop = o.progress.stop;
       // One step per evolve call: between steps, sign changes that are not simple are
       // refused and ambiguous faces keep their decision (grid/topology_guard.hpp): the start shell's
       // topology is the result's (a part thinner than a coarse voxel, the bunny's ears,
@@ -720,6 +721,8 @@ ReconstructionResult reconstruct_surface(const std::vector<Vec3d>& input, const 
       for (int step = 1; o.guard_flow && step <= o.max_steps; ++step) {
         evolve::EvolutionResult r = evolve::evolve(band, ev);
         evolve::throw_if_stopped(r, "reconstruct");
+        // A stop request ends each level's flow where it is; the remaining stages still run.
+        if (r.stop == evolve::StopReason::Stopped) break;
         stage.seconds_redistance += r.seconds.redistance;
         TopologyGuardOptions guard;
         guard.eps = 1e-3 * h;

@@ -255,6 +255,8 @@ Set read_config_file(const std::string& path, const Limits& limits) {
 }
 
 std::string place_of(const Entry& entry, std::string_view name) {
+  // Entries from a JSON request (the daemon) carry their field path, "body.evolve.speed".
+  if (entry.override_text.rfind("body.", 0) == 0) return entry.override_text;
   if (!entry.override_text.empty()) return "--set " + entry.override_text;
   if (entry.line == 0) return "--set";  // a set created by an override
   return std::string(name) + ":" + std::to_string(entry.line) + ":" + std::to_string(entry.column);

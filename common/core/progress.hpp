@@ -27,8 +27,13 @@ struct ProgressHook {
   // fraction in [0,1] of the current operation; stage names the phase ("bricks", "write").
   std::function<void(double fraction, std::string_view stage)> on_progress;
   std::shared_ptr<const CancelToken> cancel;
+  // A gentler request than cancel: an evolution-like operation ends at its next step boundary
+  // and returns the state it reached (the thesis's start / stop button; the daemon's
+  // POST /jobs/{id}/stop). Operations without steps ignore it.
+  std::shared_ptr<const CancelToken> stop;
 
   bool cancelled() const noexcept { return cancel && cancel->cancelled(); }
+  bool stop_requested() const noexcept { return stop && stop->cancelled(); }
   // Reports progress (serialised) and throws Error{Cancelled} when the token fired.
   void step(double fraction, std::string_view stage) const;
   // Throws Error{Cancelled} when the token fired; cheap enough for inner batch loops.

@@ -699,6 +699,11 @@ EvolutionResult evolve(const NarrowBand& band, const EvolutionOptions& options) 
       result.message = "cancelled after " + std::to_string(result.steps) + " steps";
       break;
     }
+    if (options.progress.stop_requested()) {
+      result.stop = StopReason::Stopped;
+      result.message = "stopped on request after " + std::to_string(result.steps) + " steps";
+      break;
+    }
     // Stage 1 (and the speeds, extended when asked).
     auto t0 = Clock::now();
     OperatorSetup setup{options};
@@ -913,6 +918,7 @@ std::string_view to_string(StopReason reason) {
     case StopReason::Cancelled: return "cancelled";
     case StopReason::NonFinite: return "non-finite";
     case StopReason::Vanished: return "vanished";
+    case StopReason::Stopped: return "stopped";
   }
   return "?";
 }

@@ -131,7 +131,9 @@ struct EvolutionOptions {
 
 // Vanished: no sign change is left in the band (the surface shrank to nothing, or the input
 // had none); the band is then emptied, its sign everywhere the one that remained.
-enum class StopReason { Completed, Cancelled, NonFinite, Vanished };
+// Stopped: options.progress.stop fired (checked before each step); the band is the state
+// reached, tidied as for any other end.
+enum class StopReason { Completed, Cancelled, NonFinite, Vanished, Stopped };
 
 struct EvolutionSeconds {
   double operator_eval = 0;     // derivatives, curvature, speed, per-voxel rates (all stages)

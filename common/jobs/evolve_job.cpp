@@ -48,9 +48,10 @@ evolve::EvolutionOptions evolution_options_from(JobContext& ctx, const config::S
   o.extension = ctx.flag(s, "extension", false);
   o.progress = ctx.options().progress;
   const int every = ctx.integer(s, "report_every", 10, 0, 1000000);
-  if (every > 0)
+  if (every > 0 || ctx.options().on_step)
     o.on_step = [&ctx, every](const evolve::StepInfo& info) {
-      if (info.step % every != 0) return;
+      if (ctx.options().on_step) ctx.options().on_step(info);
+      if (every <= 0 || info.step % every != 0) return;
       char line[200];
       std::snprintf(line, sizeof line, "step %d t %.6g dt %.3g active %llu max|speed| %.3g redistances %d", info.step,
                     info.time, info.dt, static_cast<unsigned long long>(info.active_voxels), info.max_speed,

@@ -203,6 +203,7 @@ JobContext::Raster JobContext::raster(int fallback_resolution, double fallback_b
 
 NarrowBand JobContext::input_band(const config::Set& input) const {
   const int given = (has(input, "shape") ? 1 : 0) + (has(input, "mesh") ? 1 : 0) + (has(input, "lsg") ? 1 : 0);
+  if (given == 0 && options_.input_band) return *options_.input_band;
   if (given != 1)
     throw Error(ErrorCode::InvalidArgument, options_.name,
                 "the input set needs exactly one of shape = NAME, mesh = FILE, lsg = FILE");
@@ -255,6 +256,7 @@ std::string JobContext::output_path(std::string_view file_name) const {
 }
 
 void JobContext::write_band(const NarrowBand& band, std::string_view suffix) {
+  if (options_.band_sink) options_.band_sink(band, suffix);
   const config::Set& out = output_section();
   if (!flag(out, "lsg", true)) return;
   const std::string path = output_path(std::string(stem(options_.name)) + std::string(suffix) + ".lsg");

@@ -17,6 +17,7 @@
 #pragma once
 
 #include <functional>
+#include <memory>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -26,6 +27,7 @@
 #include "config/config_file.hpp"
 #include "core/progress.hpp"
 #include "core/vec3.hpp"
+#include "evolve/evolution.hpp"
 #include "grid/narrow_band.hpp"
 #include "io/triangle_mesh.hpp"
 #include "jobs/measures_json.hpp"
@@ -40,7 +42,15 @@ struct JobOptions {
   std::string name = "job";            // errors say "NAME:LINE:COL"; also the output stem
   bool confine_inputs = false;         // inputs must resolve inside base_dir (server use)
   std::function<void(std::string_view line)> log;  // progress lines (also to OUTDIR/STEM.log)
-  ProgressHook progress;
+  ProgressHook progress;  // cancel, and stop (evolution-like jobs end at a step boundary)
+
+  // In-memory use (the daemon's sessions). input_band: the level set an input set with none of
+  // shape / mesh / lsg starts from. band_sink: receives every band the job writes as
+  // STEM<suffix>.lsg (also when output { lsg = no } leaves the file out). on_step: called after each step of the evolve job,
+  // from the calling thread (previews, checkpoints).
+  std::shared_ptr<const NarrowBand> input_band;
+  std::function<void(const NarrowBand& band, std::string_view suffix)> band_sink;
+  std::function<void(const evolve::StepInfo& step)> on_step;
 };
 
 class JobContext {

@@ -18,6 +18,7 @@ Command add_path_command(CLI::App& app, int& threads);
 Command add_voronoi_command(CLI::App& app, int& threads);
 Command add_reconstruct_command(CLI::App& app, int& threads);
 Command add_segment_command(CLI::App& app, int& threads);
+Command add_serve_command(CLI::App& app, int& threads);
 
 std::vector<Command> registered_commands(CLI::App& app, int& threads) {
   std::vector<Command> commands;
@@ -30,6 +31,7 @@ std::vector<Command> registered_commands(CLI::App& app, int& threads) {
   commands.push_back(add_voronoi_command(app, threads));
   commands.push_back(add_reconstruct_command(app, threads));
   commands.push_back(add_segment_command(app, threads));
+  commands.push_back(add_serve_command(app, threads));
   return commands;
 }
 

@@ -1,0 +1,137 @@
+// Uploads and sessions: create (primitive, band upload, or a first job), list, show, rename,
+// delete, snapshots, events, and the results (mesh, band, voxels).
+#include <cstdlib>
+
+#include "api/route.hpp"
+#include "service/api_error.hpp"
+
+namespace levelset::api {
+
+using nlohmann::json;
+using service::ApiError;
+
+namespace {
+
+const json kJson = {{"application/json", {{"schema", {{"type", "object"}}}}}};
+const json kBinary = {{"application/octet-stream", {{"schema", {{"type", "string"}, {"format", "binary"}}}}}};
+
+double query_number(const httplib::Request& req, const char* name, double fallback) {
+  if (!req.has_param(name)) return fallback;
+  const std::string v = req.get_param_value(name);
+  char* end = nullptr;
+  const double x = std::strtod(v.c_str(), &end);
+  if (end == v.c_str() || *end != 0 || !std::isfinite(x))
+    throw service::unprocessable(name, "expected a finite number, found '" + v.substr(0, 40) + "'");
+  return x;
+}
+
+std::string query_text(const httplib::Request& req, const char* name, const std::string& fallback) {
+  return req.has_param(name) ? req.get_param_value(name).substr(0, 200) : fallback;
+}
+
+void upload(RouteContext& c) {
+  const std::string format = query_text(c.req, "format", "");
+  if (!c.req.has_header("Content-Length"))
+    throw ApiError(411, "length_required", "send the file with a Content-Length");
+  auto writer = c.service.uploads().begin(c.service.config().replica, format);
+  (*c.reader)([&](const char* data, std::size_t n) { return writer->write(data, n); });
+  const json stored = c.service.uploads().finish(*writer);
+  c.reply(201, stored, "/api/v1/uploads/" + stored["id"].get<std::string>());
+}
+
+}  // namespace
+
+void add_session_routes(std::vector<Route>& r) {
+  // ---- uploads
+  {
+    Route u{"POST", "/api/v1/uploads", "Upload a file as the raw body; validated by the strict readers", true, true,
+            {"format"}, kBinary, {{"201", "stored: id, format, bytes, kind, summary"}, {"400", "malformed file"},
+                                  {"413", "too large"}, {"415", "unknown format"}}, upload};
+    r.push_back(u);
+  }
+  r.push_back({"GET", "/api/v1/uploads", "List uploads", false, false, {}, nullptr, {{"200", "uploads"}},
+               [](RouteContext& c) { c.reply(200, {{"uploads", c.service.uploads().list()}}); }});
+  r.push_back({"GET", "/api/v1/uploads/{id}", "One upload's description", false, false, {}, nullptr,
+               {{"200", "the upload"}, {"404", "unknown"}},
+               [](RouteContext& c) { c.reply(200, c.service.uploads().get(c.param(1))); }});
+  r.push_back({"DELETE", "/api/v1/uploads/{id}", "Delete an upload", true, false, {}, nullptr,
+               {{"204", "deleted"}, {"404", "unknown"}}, [](RouteContext& c) {
+                 c.service.uploads().remove(c.param(1));
+                 c.res.status = 204;
+               }});
+  // ---- sessions
+  r.push_back({"GET", "/api/v1/sessions", "List this replica's sessions", false, false, {}, nullptr,
+               {{"200", "sessions"}}, [](RouteContext& c) { c.reply(200, c.service.list_sessions()); }});
+  r.push_back({"POST", "/api/v1/sessions",
+               "Create a session: {\"primitive\": NAME, \"raster\": {...}} or {\"upload\": ID, ...op parameters}", true,
+               false, {}, kJson, {{"201", "the session (primitive, band upload)"}, {"202", "a job creates it"}},
+               [](RouteContext& c) { c.reply(c.service.create_session(c.body())); }});
+  r.push_back({"GET", "/api/v1/sessions/{id}", "One session: name, version, band summary, running job", false, false,
+               {}, nullptr, {{"200", "the session"}, {"404", "unknown"}},
+               [](RouteContext& c) { c.reply(200, c.service.sessions().get(c.param(1))->describe()); }});
+  r.push_back({"PATCH", "/api/v1/sessions/{id}", "Rename: {\"name\": NEW}", true, false, {}, kJson,
+               {{"200", "the session"}}, [](RouteContext& c) { c.reply(200, c.service.patch_session(c.param(1), c.body())); }});
+  r.push_back({"DELETE", "/api/v1/sessions/{id}", "Delete a session and its files", true, false, {}, nullptr,
+               {{"204", "deleted"}, {"409", "a job runs on it"}}, [](RouteContext& c) {
+                 c.service.sessions().remove(c.param(1));
+                 c.res.status = 204;
+               }});
+  r.push_back({"GET", "/api/v1/sessions/{id}/history", "The operations that made each version", false, false, {},
+               nullptr, {{"200", "history"}},
+               [](RouteContext& c) { c.reply(200, {{"history", c.service.sessions().get(c.param(1))->history()}}); }});
+  r.push_back({"POST", "/api/v1/sessions/{id}/snapshots", "Snapshot the current version: {\"name\": ...}", true, false,
+               {}, kJson, {{"201", "the snapshot"}},
+               [](RouteContext& c) { c.reply(c.service.snapshot(c.param(1), c.body())); }});
+  r.push_back({"GET", "/api/v1/sessions/{id}/snapshots", "List snapshots", false, false, {}, nullptr,
+               {{"200", "snapshots"}},
+               [](RouteContext& c) { c.reply(200, {{"snapshots", c.service.sessions().get(c.param(1))->snapshots()}}); }});
+  r.push_back({"POST", "/api/v1/sessions/{id}/snapshots/{sid}/restore", "Make a snapshot the next version", true,
+               false, {}, nullptr, {{"200", "the session"}, {"404", "unknown snapshot"}},
+               [](RouteContext& c) { c.reply(200, c.service.restore(c.param(1), c.param(2))); }});
+  r.push_back({"GET", "/api/v1/sessions/{id}/events", "Server-Sent Events: version changes, job states and progress",
+               false, false, {}, nullptr, {{"200", "text/event-stream"}}, [](RouteContext& c) {
+                 auto s = c.service.sessions().get(c.param(1));
+                 stream_events(c, s, s->events(), [s] { return s->describe(); });
+               }});
+  // ---- results
+  r.push_back({"GET", "/api/v1/sessions/{id}/mesh", "The surface as a mesh (chunked; ETag from version and query)",
+               false, false, {"iso", "method", "format"}, nullptr,
+               {{"200", "the mesh"}, {"304", "not modified"}, {"422", "iso beyond the band"}}, [](RouteContext& c) {
+                 service::MeshQuery q;
+                 q.iso = query_number(c.req, "iso", 0.0);
+                 q.method = query_text(c.req, "method", "mc");
+                 q.format = query_text(c.req, "format", "ply");
+                 send_blob(c, c.service.mesh(c.param(1), q));
+               }});
+  r.push_back({"GET", "/api/v1/sessions/{id}/band", "The committed band as an .lsg file", false, false, {}, nullptr,
+               {{"200", "the .lsg"}}, [](RouteContext& c) { send_blob(c, c.service.band(c.param(1))); }});
+  r.push_back({"GET", "/api/v1/sessions/{id}/voxels",
+               "Active voxels with value in [min, max] as little-endian float32 records (paged: offset, limit; "
+               "X-Fields names them, X-Total-Count counts all)",
+               false, false, {"min", "max", "fields", "offset", "limit"}, nullptr, {{"200", "records"}},
+               [](RouteContext& c) {
+                 service::VoxelQuery q;
+                 q.min = query_number(c.req, "min", -1e300);
+                 q.max = query_number(c.req, "max", 1e300);
+                 q.offset = std::uint64_t(std::max(0.0, query_number(c.req, "offset", 0)));
+                 q.limit = std::uint64_t(std::max(0.0, query_number(c.req, "limit", double(1 << 20))));
+                 if (c.req.has_param("fields")) {
+                   q.fields.clear();
+                   std::string f = query_text(c.req, "fields", "value");
+                   for (std::size_t start = 0; start <= f.size();) {
+                     const std::size_t comma = std::min(f.find(',', start), f.size());
+                     if (comma > start) q.fields.push_back(f.substr(start, comma - start));
+                     start = comma + 1;
+                   }
+                 }
+                 std::uint64_t total = 0;
+                 std::string fields;
+                 const service::Blob b = c.service.voxels(c.param(1), q, total, fields);
+                 c.res.set_header("X-Total-Count", std::to_string(total));
+                 c.res.set_header("X-Fields", fields);
+                 if (q.offset + q.limit < total) c.res.set_header("X-Next-Offset", std::to_string(q.offset + q.limit));
+                 c.res.set_content(*b.bytes, b.content_type);
+               }});
+}
+
+}  // namespace levelset::api

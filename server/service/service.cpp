@@ -1,0 +1,216 @@
+#include "service/service.hpp"
+
+#include <thread>
+
+#include "core/error.hpp"
+#include "core/file_io.hpp"
+#include "grid/lsg_file.hpp"
+#include "service/api_error.hpp"
+#include "service/ids.hpp"
+#include "service/operations.hpp"
+
+#ifndef LEVELSET_VERSION
+#define LEVELSET_VERSION "0.0.0"
+#endif
+
+namespace levelset::service {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+Service::Service(ServiceConfig config) : config_(std::move(config)), data_(config_.data_dir) {
+  std::error_code ec;
+  fs::create_directories(data_ / "jobs", ec);
+  if (ec) throw Error(ErrorCode::IoError, data_.string(), "cannot create the data directory: " + ec.message());
+  sessions_ = std::make_unique<SessionStore>(
+      data_ / "sessions",
+      SessionLimits{config_.max_sessions, config_.max_session_voxels, config_.max_band_memory});
+  uploads_ = std::make_unique<UploadStore>(data_ / "uploads", config_.max_upload_bytes, config_.max_uploads_total);
+  startup_problems_ = sessions_->load_all();
+  const unsigned cores = std::max(1u, std::thread::hardware_concurrency());
+  scheduler_ = std::make_unique<JobScheduler>(config_.max_jobs, config_.max_queued_jobs,
+                                              int(std::max(1u, cores / unsigned(config_.max_jobs))),
+                                              [this](Job& job) { run_job(job); });
+  load_journal();
+  ready_ = true;
+}
+
+Service::~Service() { shutdown(std::chrono::steady_clock::now()); }
+
+void Service::shutdown(std::chrono::steady_clock::time_point deadline) {
+  ready_ = false;
+  if (scheduler_) scheduler_->shutdown(deadline);
+}
+
+fs::path Service::job_dir(const std::string& job_id) const { return data_ / "jobs" / job_id; }
+
+void Service::load_journal() {
+  std::error_code ec;
+  for (const fs::directory_entry& e : fs::directory_iterator(data_ / "jobs", ec)) {
+    const std::string name = e.path().filename().string();
+    if (e.path().extension() != ".json" || !is_valid_id(e.path().stem().string(), 'j')) continue;
+    try {
+      auto job = Job::from_journal(e.path());
+      const JobState s = job->state();
+      if (s == JobState::Queued || s == JobState::Running)
+        job->set_state(JobState::Interrupted, {{"reason", "the server stopped while the job " +
+                                                              std::string(s == JobState::Running ? "ran" : "waited")}});
+      job->events().close();
+      scheduler_->adopt(job);
+    } catch (const Error& err) {
+      startup_problems_.push_back(name + ": " + err.what());
+    }
+  }
+}
+
+json Service::api_info() const {
+  json ops = json::array();
+  for (const OperationInfo& o : operations())
+    ops.push_back({{"op", o.name},
+                   {"kind", o.kind == OperationInfo::Modifies ? "modifies" : o.kind == OperationInfo::Creates ? "creates" : "reads"},
+                   {"stoppable", o.evolution_like},
+                   {"summary", o.summary}});
+  return {{"name", "levelsetd"},
+          {"version", LEVELSET_VERSION},
+          {"api", "v1"},
+          {"replica", config_.replica},
+          {"operations", ops},
+          {"upload_formats", {"off", "ply", "obj", "stl", "tria", "xyz", "xyzn", "pwn", "inr", "nrrd", "lsg"}},
+          {"limits",
+           {{"max_jobs", config_.max_jobs},
+            {"max_queued_jobs", config_.max_queued_jobs},
+            {"max_sessions", config_.max_sessions},
+            {"max_session_voxels", config_.max_session_voxels},
+            {"max_band_memory", config_.max_band_memory},
+            {"max_upload_bytes", config_.max_upload_bytes},
+            {"max_uploads_total", config_.max_uploads_total},
+            {"max_body_bytes", config_.max_body_bytes},
+            {"max_formula_length", config_.max_formula_length},
+            {"max_streams", config_.max_streams}}}};
+}
+
+std::string Service::metrics() const {
+  std::string out;
+  auto metric = [&](const char* name, const char* type, const char* help, double value) {
+    out += std::string("# HELP ") + name + " " + help + "\n# TYPE " + name + " " + type + "\n" + name + " " +
+           std::to_string(value) + "\n";
+  };
+  metric("levelset_requests_total", "counter", "HTTP requests answered", double(requests_total.load()));
+  metric("levelset_request_errors_total", "counter", "HTTP requests answered with a status >= 400",
+         double(request_errors_total.load()));
+  metric("levelset_sessions", "gauge", "Sessions held", double(sessions_->count()));
+  metric("levelset_band_memory_bytes", "gauge", "Memory of all sessions' bands", double(sessions_->band_memory()));
+  metric("levelset_jobs_running", "gauge", "Jobs running", double(scheduler_->running()));
+  metric("levelset_jobs_queued", "gauge", "Jobs waiting", double(scheduler_->queued()));
+  metric("levelset_jobs_succeeded_total", "counter", "Jobs that succeeded", double(jobs_succeeded_.load()));
+  metric("levelset_jobs_failed_total", "counter", "Jobs that failed", double(jobs_failed_.load()));
+  metric("levelset_streams_open", "gauge", "Open event streams", double(streams_open.load()));
+  metric("levelset_uploads_bytes", "gauge", "Bytes held by uploads", double(uploads_->total_bytes()));
+  return out;
+}
+
+// ---- sessions -------------------------------------------------------------------------------
+
+json Service::list_sessions() const {
+  json out = json::array();
+  for (const auto& s : sessions_->list()) out.push_back(s->describe());
+  return {{"sessions", out}, {"replica", config_.replica}};
+}
+
+Reply Service::create_session(const json& body) {
+  if (!body.is_object()) throw bad_request("expected a JSON object");
+  const std::string name = body.value("name", "");
+  if (name.size() > 200) throw unprocessable("body.name", "longer than 200 characters");
+  if (body.contains("primitive")) {
+    // A built-in shape: the closest thing to `levelsetd primitive`, synchronous (bounded by
+    // the raster's limits).
+    if (!body["primitive"].is_string()) throw unprocessable("body.primitive", "expected a shape name");
+    json request = {{"op", "cpt"}, {"input", {{"shape", body["primitive"]}}}};
+    if (body.contains("raster")) request["raster"] = body["raster"];
+    OperationContext ctx;
+    ctx.request = request;
+    ctx.uploads_dir = uploads_->dir();
+    ctx.work_dir = data_;
+    ctx.max_formula_length = config_.max_formula_length;
+    OperationResult r = run_operation(ctx);
+    auto s = sessions_->create(config_.replica, name, std::move(*r.band), {{"primitive", body["primitive"]}, {"raster", body.value("raster", json::object())}});
+    return {201, s->describe(), "/api/v1/sessions/" + s->id()};
+  }
+  if (!body.contains("upload") || !body["upload"].is_string())
+    throw bad_request("expected \"primitive\": NAME or \"upload\": UPLOAD_ID (and \"name\")");
+  const std::string upload = body["upload"].get<std::string>();
+  const json meta = uploads_->get(upload);
+  const std::string kind = meta.value("kind", "");
+  if (kind == "band") {
+    NarrowBand band = load_lsg(uploads_->path_of(upload)).band;
+    auto s = sessions_->create(config_.replica, name, std::move(band), {{"upload", upload}});
+    return {201, s->describe(), "/api/v1/sessions/" + s->id()};
+  }
+  // Meshes, point clouds and images become sessions through their first job.
+  json request = body;
+  request.erase("upload");
+  json input = request.value("input", json::object());
+  if (kind == "mesh") {
+    request["op"] = "cpt";
+    input["mesh"] = upload;
+  } else if (kind == "points") {
+    request["op"] = "reconstruct";
+    input["points"] = upload;
+  } else if (kind == "image") {
+    request["op"] = "segment";
+    input["image"] = upload;
+  } else {
+    throw unprocessable("body.upload", "the upload's kind '" + kind + "' cannot start a session");
+  }
+  request["input"] = input;
+  return submit("", request);
+}
+
+json Service::patch_session(const std::string& id, const json& body) {
+  auto s = sessions_->get(id);
+  if (!body.is_object() || !body.contains("name") || !body["name"].is_string())
+    throw bad_request("expected {\"name\": NEW_NAME}");
+  const std::string name = body["name"].get<std::string>();
+  if (name.empty() || name.size() > 200) throw unprocessable("body.name", "expected 1 to 200 characters");
+  sessions_->rename(*s, name);
+  return s->describe();
+}
+
+Reply Service::snapshot(const std::string& id, const json& body) {
+  auto s = sessions_->get(id);
+  const json snap = sessions_->snapshot(*s, config_.replica, body.is_object() ? body.value("name", "") : "");
+  return {201, snap, "/api/v1/sessions/" + id + "/snapshots"};
+}
+
+json Service::restore(const std::string& id, const std::string& snapshot_id) {
+  auto s = sessions_->get(id);
+  if (!s->claim("restore")) throw conflict("a job runs on session " + id);
+  try {
+    sessions_->restore(*s, snapshot_id);
+  } catch (...) {
+    s->release("restore");
+    throw;
+  }
+  s->release("restore");
+  return s->describe();
+}
+
+// ---- idempotency ----------------------------------------------------------------------------
+
+std::optional<std::pair<int, std::string>> Service::replay(const std::string& key) {
+  std::lock_guard lock(idempotency_mutex_);
+  auto it = idempotency_.find(key);
+  if (it == idempotency_.end()) return std::nullopt;
+  return it->second.second;
+}
+
+void Service::remember(const std::string& key, int status, const std::string& body) {
+  std::lock_guard lock(idempotency_mutex_);
+  const auto now = std::chrono::steady_clock::now();
+  for (auto it = idempotency_.begin(); it != idempotency_.end();)
+    it = now - it->second.first > std::chrono::hours(24) ? idempotency_.erase(it) : std::next(it);
+  if (idempotency_.size() >= 10000) idempotency_.erase(idempotency_.begin());
+  idempotency_.emplace(key, std::make_pair(now, std::make_pair(status, body)));
+}
+
+}  // namespace levelset::service
