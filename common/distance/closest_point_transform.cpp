@@ -12,6 +12,7 @@
 #include "core/text.hpp"
 #include "distance/brick_triangle_lists.hpp"
 #include "distance/inside_masks.hpp"
+#include "distance/membrane_band.hpp"
 #include "distance/orient_faces.hpp"
 #include "distance/unique_faces.hpp"
 #include "distance/winding_number.hpp"
@@ -24,13 +25,6 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 double since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
-
-// Per-brick result before packing.
-struct BrickDistances {
-  BrickMask active;
-  std::vector<float> distance;       // unsigned, packed in active order
-  std::vector<Vec3f> closest_point;  // packed in active order (when requested)
-};
 
 void check_budget(const TriangleMesh& mesh, const CptOptions& options) {
   if (mesh.triangles.empty())
@@ -149,7 +143,8 @@ CptResult closest_point_transform(const TriangleMesh& mesh, const CptOptions& op
   // Unsigned distances per brick (the mesh as given: orientation does not change distances).
   t = Clock::now();
   const std::size_t nb = lists.bricks.size();
-  std::vector<BrickDistances> per_brick(nb);
+  // Per-brick results before packing (distances unsigned, packed in active order).
+  std::vector<MembraneBrick> per_brick(nb);
   const double r = options.frame.half_width * options.frame.voxel_size;
   const double band2 = r * r;
   const std::size_t batch = 512;
@@ -168,7 +163,8 @@ CptResult closest_point_transform(const TriangleMesh& mesh, const CptOptions& op
           scan_triangle(mesh.vertices[f[0]], mesh.vertices[f[1]], mesh.vertices[f[2]], tri,
                         lists.bricks[i], options.frame, band2, dist2, dist, owner);
         }
-        BrickDistances& out = per_brick[i];
+        MembraneBrick& out = per_brick[i];
+        out.coord = lists.bricks[i];
         const Coord o = brick_origin(lists.bricks[i]);
         for (int n = 0; n < kBrickVoxels; ++n) {
           if (!(dist2[n] <= band2)) continue;
@@ -199,17 +195,40 @@ CptResult closest_point_transform(const TriangleMesh& mesh, const CptOptions& op
   sign_options.progress = options.progress;
   const InsideMasksResult signs = compute_inside_masks(oriented.mesh, tree, lists, sign_options);
   result.winding_queries = signs.winding_queries;
+  result.open_edges = signs.open_edges;
+  for (std::size_t i = 0; i < nb; ++i) per_brick[i].inside = signs.inside[i];
   result.seconds.sign = since(t);
   options.progress.step(0.9, "sign");
 
-  // Pack bricks with active voxels in key order (lists are sorted by key).
+  // Open meshes: the sign also changes where w crosses 1/2 away from the mesh (across holes);
+  // put those membranes into the band (membrane_band.hpp). Closed meshes have no open edges,
+  // so w is piecewise constant and every sign change lies on the mesh: nothing to do.
+  if (signs.open_edges > 0) {
+    t = Clock::now();
+    MembraneOptions membrane;
+    membrane.frame = options.frame;
+    membrane.search_bounds = oriented.mesh.bounds();
+    membrane.closest_points = options.closest_points;
+    membrane.progress = options.progress;
+    const MembraneResult closed = close_membranes(tree, per_brick, membrane);
+    result.membrane_voxels = closed.membrane_voxels;
+    result.membrane_bricks_added = closed.bricks_added;
+    result.membrane_voxels_added = closed.voxels_added;
+    result.membrane_truncated_bricks = closed.truncated_bricks;
+    result.winding_queries += closed.winding_queries;
+    result.seconds.membrane = since(t);
+    options.progress.step(0.95, "membrane");
+  }
+
+  // Pack bricks with active voxels in key order (per_brick is sorted by key).
   t = Clock::now();
+  const std::size_t np = per_brick.size();
   std::vector<BrickRecord> records;
   std::vector<std::uint64_t> offsets;
   std::uint64_t total = 0;
-  for (std::size_t i = 0; i < nb; ++i) {
+  for (std::size_t i = 0; i < np; ++i) {
     if (per_brick[i].active.none()) continue;
-    records.push_back({lists.bricks[i], per_brick[i].active, signs.inside[i]});
+    records.push_back({per_brick[i].coord, per_brick[i].active, per_brick[i].inside});
     offsets.push_back(total);
     total += per_brick[i].distance.size();
   }
@@ -219,10 +238,10 @@ CptResult closest_point_transform(const TriangleMesh& mesh, const CptOptions& op
   if (options.closest_points) result.closest_points.resize(total);
   std::vector<std::size_t> kept;
   kept.reserve(records.size());
-  for (std::size_t i = 0; i < nb; ++i)
+  for (std::size_t i = 0; i < np; ++i)
     if (!per_brick[i].active.none()) kept.push_back(i);
   tbb::parallel_for(std::size_t(0), kept.size(), [&](std::size_t j) {
-    const BrickDistances& bd = per_brick[kept[j]];
+    const MembraneBrick& bd = per_brick[kept[j]];
     const BrickMask& inside = records[j].inside;
     float* dst = values.data() + offsets[j];
     std::size_t k = 0;

@@ -42,7 +42,7 @@ struct CptOptions {
 };
 
 struct CptTimings {
-  double orient = 0, bin = 0, distance = 0, sign = 0, assemble = 0, total = 0;
+  double orient = 0, bin = 0, distance = 0, sign = 0, membrane = 0, assemble = 0, total = 0;
 };
 
 struct CptResult {
@@ -52,6 +52,11 @@ struct CptResult {
   std::uint64_t brick_triangle_pairs = 0;
   std::uint64_t faces_flipped = 0;  // by the orientation pass
   std::uint64_t winding_queries = 0;
+  std::uint64_t open_edges = 0;                 // of the oriented sign mesh (0: closed)
+  std::uint64_t membrane_voxels = 0;            // ends of sign changes across holes
+  std::uint64_t membrane_bricks_added = 0;      // bricks beyond the mesh's band
+  std::uint64_t membrane_voxels_added = 0;      // active voxels beyond the mesh's band
+  std::uint64_t membrane_truncated_bricks = 0;  // membrane left open there (see membrane_band)
   CptTimings seconds;
 };
 
