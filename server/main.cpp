@@ -13,6 +13,7 @@
 #include "commands/commands.hpp"
 #include "core/error.hpp"
 #include "core/file_io.hpp"
+#include "core/memory_budget.hpp"
 #include "core/text.hpp"
 #include "commands/output_check.hpp"
 #include "evolve/speed.hpp"
@@ -28,6 +29,11 @@ int main(int argc, char** argv) {
   app.add_flag("--allow-special-outputs", allow_special,
                "Let outputs write into an existing character device or FIFO (e.g. --stats /dev/stdout); "
                "without it such destinations, and symbolic links, are refused");
+  std::uint64_t memory_budget = 0;
+  app.add_option("--memory-budget", memory_budget,
+                 "Memory one command may allocate for what its input files claim, checked before reading "
+                 "(e.g. 8G, 512MiB; default: half the physical memory, at most 4 GiB)")
+      ->transform(CLI::AsSizeValue(false));
   int threads = 0;
 
   levelset::cli::InfoArgs info;
@@ -146,6 +152,7 @@ int main(int argc, char** argv) {
     return 2;
   }
 
+  if (memory_budget > 0) levelset::set_default_memory_budget(memory_budget);
   std::optional<tbb::global_control> limit;
   if (threads > 0) limit.emplace(tbb::global_control::max_allowed_parallelism, threads);
 

@@ -63,6 +63,31 @@ VolumeArea measure_front(const NarrowBand& band) {
 
 }  // namespace
 
+std::uint64_t segmentation_memory_bytes(const ImageVolume& image, const SegmentationOptions& o) {
+  const double voxels = double(image.voxel_count());
+  double bytes = 5.0 * sizeof(float) * voxels;  // edge indicator: normal/smoothed/g + grad g (3)
+  if (o.label_mask) bytes += voxels;
+  // The front: at most about the image box's surface, 2 W voxels thick, ~16 bytes per active
+  // voxel with the evolution's copies of the band.
+  const double h = o.voxel_size > 0 ? o.voxel_size : std::min({image.spacing.x, image.spacing.y, image.spacing.z});
+  if (std::isfinite(h) && h > 0) {
+    const double ax = double(image.nx) * image.spacing.x / h + 1, ay = double(image.ny) * image.spacing.y / h + 1,
+                 az = double(image.nz) * image.spacing.z / h + 1;
+    bytes += 2.0 * (ax * ay + ay * az + az * ax) * 2.0 * std::max(2.0, o.half_width) * 16.0;
+  }
+  return bytes >= 1.8e19 ? ~std::uint64_t{0} : std::uint64_t(bytes);
+}
+
+void require_segmentation_budget(const ImageVolume& image, std::uint64_t file_bytes, const SegmentationOptions& o,
+                                 const std::string& where) {
+  const std::uint64_t samples = image.voxel_count() * sizeof(float);
+  const std::uint64_t work = segmentation_memory_bytes(image, o);
+  const std::uint64_t need = std::max(file_bytes + samples, samples + work);
+  require_within_budget(need, o.memory_budget, where,
+                        "segmenting a " + std::to_string(image.nx) + " x " + std::to_string(image.ny) + " x " +
+                            std::to_string(image.nz) + " image");
+}
+
 std::vector<std::uint8_t> inside_mask(const NarrowBand& band, const ImageVolume& image) {
   std::vector<std::uint8_t> mask(image.voxel_count(), 0);
   tbb::parallel_for(tbb::blocked_range<std::int64_t>(0, image.nz), [&](const tbb::blocked_range<std::int64_t>& r) {
@@ -99,6 +124,7 @@ SegmentationResult segment_image(const ImageVolume& image, const SegmentationOpt
     throw Error(ErrorCode::LimitExceeded, "segment_image",
                 "the image box holds " + format_number(cells) + " grid voxels of size " + format_number(h) +
                     ", above the limit of " + std::to_string(o.max_grid_voxels));
+  require_segmentation_budget(image, 0, o, "segment_image");
   const double default_radius = o.seed_radius > 0 ? o.seed_radius : 3 * h;
   std::vector<SegmentationSeed> seeds = o.seeds;
   BBox seed_bounds;

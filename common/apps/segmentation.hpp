@@ -28,12 +28,15 @@
 //   image voxels whose centre is inside: trilinear level set value < 0).
 // Cost: O(voxels) for g (plus the smoothing); per step O(active voxels) (27-point curvature
 //   stencil); each check one marching cubes pass. Memory: about 6 floats per image voxel plus
-//   the band.
+//   the band: segmentation_memory_bytes estimates it from the image's dimensions alone, and
+//   segment_image refuses (LimitExceeded) before allocating when image + estimate exceed
+//   options.memory_budget. Callers that read the image check it before reading (the CLI and
+//   the segment job read the header first).
 // Threading: TBB everywhere; identical results for any thread count.
 // Errors: Error{InvalidArgument} for no seeds, a non-finite or outside-the-image seed centre, a
 //   seed radius below one grid voxel, bad parameters (negative or non-finite values, both steps
 //   and time), those of edge_indicator; Error{LimitExceeded} when the image box holds more
-//   grid voxels than max_grid_voxels; Error{Cancelled} by options.progress. An evolution that
+//   grid voxels than max_grid_voxels or the memory estimate exceeds memory_budget; Error{Cancelled} by options.progress. An evolution that
 //   meets a NaN stops with stop = NonFinite (nothing thrown), as evolve does.
 #pragma once
 
@@ -43,6 +46,7 @@
 #include <vector>
 
 #include "apps/edge_indicator.hpp"
+#include "core/memory_budget.hpp"
 #include "core/progress.hpp"
 #include "evolve/evolution.hpp"
 #include "grid/narrow_band.hpp"
@@ -88,6 +92,8 @@ struct SegmentationOptions {
   evolve::Scheme scheme = evolve::Scheme::Upwind1;
   int rk_order = 1;
   std::uint64_t max_grid_voxels = std::uint64_t{1} << 28;  // grid voxels in the image box (~6 floats each)
+  // Image samples + segmentation_memory_bytes must fit (core/memory_budget.hpp, --memory-budget).
+  std::uint64_t memory_budget = default_memory_budget();
   bool label_mask = false;        // fill SegmentationResult::label_mask
   std::function<void(const SegmentationCheck&)> on_check;
   ProgressHook progress;          // fraction of max_time (or steps / time); cancellable
@@ -111,6 +117,19 @@ struct SegmentationResult {
 };
 
 SegmentationResult segment_image(const ImageVolume& image, const SegmentationOptions& options);
+
+// What segment_image allocates at its peak beyond the image's own samples, from the image's
+// dimensions and spacing only (image.samples may be empty: a header is enough): the edge
+// indicator's working set (5 floats per image voxel while smoothing and differencing; g and
+// grad g stay for the evolution), the label mask (1 byte per voxel, when asked for), and the
+// band of a front as large as the image box's surface (grid voxels of options.voxel_size).
+std::uint64_t segmentation_memory_bytes(const ImageVolume& image, const SegmentationOptions& options);
+
+// Refuses (Error{LimitExceeded} at `where`, naming options.memory_budget and --memory-budget)
+// an image whose samples, read from a file of file_bytes, plus segmentation_memory_bytes would
+// not fit options.memory_budget. For callers that hold only the image's header.
+void require_segmentation_budget(const ImageVolume& image, std::uint64_t file_bytes,
+                                 const SegmentationOptions& options, const std::string& where);
 
 // Image voxels whose centre lies inside the band's zero level (trilinear value < 0): 1, else 0;
 // x fastest. TBB over z-slices.

@@ -12,9 +12,15 @@
 //     so zstd sees slowly varying exponent bytes together); with flag bit 1, then the closest
 //     surface point of every active voxel (all x, all y, all z as f32, byte-shuffled likewise).
 // Reading checks, in order: size >= header, magic (UnsupportedFormat), version (newer:
-// UnsupportedVersion), header fields, truncation (Truncated), checksum (Corrupt), payload size
-// and structure (sorted unique bricks, popcounts, finite values, signs agree: Corrupt).
-// Allocation is bounded by the bytes actually decompressed, never by a header count alone.
+// UnsupportedVersion), header fields, truncation (Truncated), checksum (Corrupt), counts and
+// raw size against the limits, the compression ratio and the memory budget (LimitExceeded),
+// then the payload as it streams out of zstd in small pieces: sorted unique bricks in range,
+// mask popcounts never above the header's voxel count, finite values, signs agree (Corrupt).
+// Resource bounds (a small file never costs much): the raw size may be at most
+// max_compression_ratio times the stored size (plus 1 MiB), and what the decoded band will
+// hold must fit memory_budget, both checked before decompressing anything; the decompressed
+// payload is never held whole (pieces of ZSTD_DStreamOutSize()), bricks grow with what was
+// decoded, and values are allocated only once the decoded masks confirm their count.
 // Writing goes through write_file_atomically: a crash never leaves a half file.
 // Cost: O(active voxels); zstd level 3 runs at a few hundred MB/s.
 #pragma once
@@ -26,6 +32,7 @@
 #include <string>
 #include <string_view>
 
+#include "core/memory_budget.hpp"
 #include "core/progress.hpp"
 #include "grid/narrow_band.hpp"
 
@@ -39,10 +46,21 @@ struct LsgWriteOptions {
   std::span<const Vec3f> closest_points;
 };
 
+// Real bands written by levelsetd compress 1.4:1 (knot) to 3:1 (sphere) and up to ~900:1
+// (the flat faces of a box at 2048^3, the most compressible shape measured); zstd itself cannot
+// exceed ~32000:1. 4096 leaves a factor 4.5 of margin above the best real file.
+inline constexpr double kLsgMaxCompressionRatio = 4096.0;
+inline constexpr std::uint64_t kLsgRatioSlackBytes = std::uint64_t{1} << 20;
+
 struct LsgReadOptions {
   std::uint64_t max_file_bytes = std::uint64_t{1} << 36;
   std::uint64_t max_active_voxels = (std::uint64_t{1} << 32) - 1;
   std::uint64_t max_raw_bytes = std::uint64_t{1} << 34;  // decompressed payload (16 GiB)
+  // raw bytes <= max_compression_ratio * stored bytes + kLsgRatioSlackBytes
+  double max_compression_ratio = kLsgMaxCompressionRatio;
+  // Bytes the decode may hold at its peak (the file, the bricks, the values); see
+  // core/memory_budget.hpp (levelsetd --memory-budget).
+  std::uint64_t memory_budget = default_memory_budget();
   ProgressHook progress;
 };
 
@@ -70,6 +88,14 @@ struct LsgWriteResult {
   std::uint64_t raw_bytes = 0;
 };
 
+// What levelsetd info reports without keeping the values (summarize_lsg).
+struct LsgSummary {
+  LsgHeader header;
+  std::uint64_t file_bytes = 0;
+  std::uint64_t memory_bytes = 0;  // NarrowBand::memory_bytes() of the decoded band
+  IndexBox active_index_bounds;    // NarrowBand::active_index_bounds() of the decoded band
+};
+
 // Encodes to bytes (what save_lsg writes).
 std::string encode_lsg(const NarrowBand& band, const LsgWriteOptions& options = {});
 LsgWriteResult save_lsg(const NarrowBand& band, const std::filesystem::path& path,
@@ -79,5 +105,11 @@ LsgWriteResult save_lsg(const NarrowBand& band, const std::filesystem::path& pat
 LsgReadResult decode_lsg(std::string_view bytes, std::string_view name,
                          const LsgReadOptions& options = {});
 LsgReadResult load_lsg(const std::filesystem::path& path, const LsgReadOptions& options = {});
+
+// The same checks and errors as decode_lsg (the whole payload is streamed and validated), but
+// only the bricks' coordinates and masks are kept, never the values: memory about 140 bytes
+// per brick plus 2 bits per active voxel.
+LsgSummary summarize_lsg(std::string_view bytes, std::string_view name, const LsgReadOptions& options = {});
+LsgSummary summarize_lsg_file(const std::filesystem::path& path, const LsgReadOptions& options = {});
 
 }  // namespace levelset

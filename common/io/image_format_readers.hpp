@@ -32,6 +32,10 @@ class ByteStream {
   std::uint64_t position() const { return position_; }
   // Gives bytes back: the next read() returns them first (position moves back).
   void unread(std::string_view bytes);
+  // True when the bytes are inflated (skip() would have to decompress).
+  bool inflating() const { return inflater_ != nullptr; }
+  // Plain streams only: moves past up to n bytes without copying; returns how many.
+  std::uint64_t skip(std::uint64_t n);
 
  private:
   struct Inflater;
@@ -55,13 +59,14 @@ struct SampleLayout {
   bool big_endian = false;
 };
 
-// Error{LimitExceeded} at `where` when the image exceeds the options' voxel or memory budget
-// (also on overflow of nx*ny*nz).
+// Error{LimitExceeded} at `where` when the image exceeds the options' voxel or sample limits
+// (also on overflow of nx*ny*nz), or, when its samples are to be loaded, the memory budget.
 void check_image_limits(const SampleLayout& layout, const ImageReadOptions& options,
                         const std::string& where);
 
 // Reads the layout's samples from the stream into out.image.samples (and min/max), growing
-// the array as data arrive. byte_base: the stream offset of the data's first byte, for
+// the array as data arrive; with options.samples Scan only checks them (and min/max), with
+// Skip reads nothing from gzip data and only checks the length of plain data. byte_base: the stream offset of the data's first byte, for
 // messages "name @ byte N". Throws Truncated, NonFinite (float samples), Cancelled.
 void read_samples(ByteStream& stream, const SampleLayout& layout, std::uint64_t byte_base,
                   std::string_view name, const ImageReadOptions& options, ImageReadResult& out);

@@ -22,8 +22,9 @@
 //   ParseError        malformed header line, value or field; where = "name:LINE"
 //   Truncated         data shorter than the header says; where = "name @ byte N" (N counted
 //                     in the decompressed stream for gzip data)
-//   LimitExceeded     voxels above max_voxels, samples above max_sample_bytes, a header
-//                     longer than 1 MiB, a file above max_file_bytes
+//   LimitExceeded     voxels above max_voxels, samples above max_sample_bytes or (when they
+//                     are loaded) above memory_budget, a header longer than 1 MiB, a file
+//                     above max_file_bytes
 //   NonFinite         NaN/Inf spacing, origin or float sample (Inf samples pass with
 //                     allow_infinite); where = line or byte
 //   UnsupportedFormat unknown magic, type, encoding, CPU; VDIM > 1; rotated or flipped axes;
@@ -31,10 +32,16 @@
 //   Corrupt           broken gzip stream
 //   IoError           (read_image only) a file cannot be read
 //   Cancelled         the progress hook's token fired
-// Cost: one pass, O(voxels) time; memory: the file plus 4 bytes per voxel (gzip data is
-//   inflated in 1 MiB pieces straight into the samples, which grow only as data arrives, so
-//   a small file claiming a huge image fails with Truncated without allocating it, and a
-//   gzip bomb stops at the header's size).
+// Samples (options.samples): Load (the default) decodes them into image.samples; Scan decodes
+//   and checks them (NonFinite, Truncated, min/max) without keeping them; Skip reads the header
+//   only (image.samples stays empty, min/max 0): gzip data are not inflated at all, plain data
+//   are only checked to be long enough (Truncated). Skip is what describing a file needs: its
+//   cost does not depend on the image's size.
+// Cost: one pass, O(voxels) time (Skip: O(header)); memory: the file plus 4 bytes per voxel
+//   with Load (gzip data are inflated in 1 MiB pieces straight into the samples, which grow
+//   only as data arrives, so a small file claiming a huge image fails with Truncated without
+//   allocating it, and a gzip bomb stops at the header's size), the file plus O(1) otherwise.
+//   The 4 bytes per voxel are checked against memory_budget before any sample is read.
 // Threading: reentrant; no shared state.
 #pragma once
 
@@ -43,6 +50,7 @@
 #include <string>
 #include <string_view>
 
+#include "core/memory_budget.hpp"
 #include "core/progress.hpp"
 #include "io/image_volume.hpp"
 
@@ -51,10 +59,15 @@ namespace levelset {
 enum class ImageFormat { Inr, Nrrd };
 std::string_view to_string(ImageFormat format);  // "inr", "nrrd"
 
+enum class ImageSamples { Load, Scan, Skip };
+
 struct ImageReadOptions {
   std::uint64_t max_file_bytes = std::uint64_t{1} << 34;     // compressed / on-disk bytes
   std::uint64_t max_voxels = std::uint64_t{1} << 28;          // 1 GiB of float samples
   std::uint64_t max_sample_bytes = std::uint64_t{1} << 30;   // 4 bytes per voxel in memory
+  // Load: the samples (4 bytes per voxel) must fit; core/memory_budget.hpp (--memory-budget).
+  std::uint64_t memory_budget = default_memory_budget();
+  ImageSamples samples = ImageSamples::Load;
   bool allow_infinite = false;  // +-Inf float samples (cost grids: +Inf = blocked); NaN never
   ProgressHook progress;
 };
@@ -67,7 +80,7 @@ struct ImageReadResult {
   bool gzip = false;         // the data were gzip-compressed
   bool detached = false;     // NRRD data in a separate file
   std::uint64_t file_bytes = 0;  // bytes of the file(s) read
-  float min_sample = 0, max_sample = 0;
+  float min_sample = 0, max_sample = 0;  // Load and Scan only
 };
 
 ImageReadResult read_image(const std::filesystem::path& path, const ImageReadOptions& options = {});

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "core/error.hpp"
+#include "core/memory_budget.hpp"
 #include "io/image_format_readers.hpp"
 
 namespace levelset::detail {
@@ -39,6 +40,18 @@ ByteStream::~ByteStream() = default;
 void ByteStream::unread(std::string_view bytes) {
   pending_.insert(0, bytes);
   position_ -= bytes.size();
+}
+
+std::uint64_t ByteStream::skip(std::uint64_t n) {
+  std::uint64_t done = std::min<std::uint64_t>(n, pending_.size());
+  pending_.erase(0, std::size_t(done));
+  if (!inflater_) {
+    const std::uint64_t k = std::min<std::uint64_t>(n - done, bytes_.size() - offset_);
+    offset_ += std::size_t(k);
+    done += k;
+  }
+  position_ += done;
+  return done;
 }
 
 std::size_t ByteStream::read(char* dst, std::size_t n) {
@@ -142,6 +155,10 @@ void check_image_limits(const SampleLayout& l, const ImageReadOptions& options, 
     throw Error(ErrorCode::LimitExceeded, where,
                 std::to_string(voxels) + " voxels need " + std::to_string(voxels * sizeof(float)) +
                     " bytes, above the budget of " + std::to_string(options.max_sample_bytes));
+  if (options.samples == ImageSamples::Load)
+    require_within_budget(voxels * sizeof(float), options.memory_budget, where,
+                          "the samples of a " + std::to_string(l.nx) + " x " + std::to_string(l.ny) + " x " +
+                              std::to_string(l.nz) + " image");
 }
 
 namespace {
@@ -190,10 +207,29 @@ void read_samples(ByteStream& stream, const SampleLayout& layout, std::uint64_t 
   const int size = sample_size(layout.type);
   const bool swap = layout.big_endian != (std::endian::native == std::endian::big);
   const bool floating = layout.type == SampleType::Float32 || layout.type == SampleType::Float64;
+  out.image.nx = layout.nx;
+  out.image.ny = layout.ny;
+  out.image.nz = layout.nz;
+  out.sample_type = std::string(sample_type_name(layout.type));
+  out.big_endian = layout.big_endian;
   std::vector<float>& samples = out.image.samples;
   samples.clear();
+  if (options.samples == ImageSamples::Skip) {
+    // The header describes the image; plain data are checked for length (free), gzip data are
+    // left compressed (inflating them would cost what the header claims).
+    if (!stream.inflating()) {
+      const std::uint64_t need = voxels * std::uint64_t(size);
+      const std::uint64_t got = stream.skip(need);
+      if (got < need)
+        throw Error(ErrorCode::Truncated, at_byte(name, byte_base + got),
+                    "image data end after " + std::to_string(got / size) + " of " + std::to_string(voxels) +
+                        " samples (" + std::to_string(need) + " bytes expected)");
+    }
+    return;
+  }
+  const bool keep = options.samples == ImageSamples::Load;
   // Grow with the data (a short stream must not allocate the header's full claim).
-  samples.reserve(std::size_t(std::min<std::uint64_t>(voxels, std::uint64_t{1} << 22)));
+  if (keep) samples.reserve(std::size_t(std::min<std::uint64_t>(voxels, std::uint64_t{1} << 22)));
   constexpr std::size_t kChunkSamples = std::size_t{1} << 18;
   std::vector<unsigned char> buffer(std::size_t(std::min<std::uint64_t>(voxels, kChunkSamples)) * size);
   float lo = std::numeric_limits<float>::infinity(), hi = -lo;
@@ -209,7 +245,7 @@ void read_samples(ByteStream& stream, const SampleLayout& layout, std::uint64_t 
                     "sample " + std::to_string(done + s) + " is not a finite number");
       lo = std::min(lo, v);
       hi = std::max(hi, v);
-      samples.push_back(v);
+      if (keep) samples.push_back(v);
     }
     done += whole;
     if (got < want * size)
@@ -221,11 +257,6 @@ void read_samples(ByteStream& stream, const SampleLayout& layout, std::uint64_t 
       next_report = done + (std::uint64_t{1} << 24);
     }
   }
-  out.image.nx = layout.nx;
-  out.image.ny = layout.ny;
-  out.image.nz = layout.nz;
-  out.sample_type = std::string(sample_type_name(layout.type));
-  out.big_endian = layout.big_endian;
   out.min_sample = voxels ? lo : 0.0f;
   out.max_sample = voxels ? hi : 0.0f;
 }

@@ -244,7 +244,8 @@ ImageReadResult read_nrrd(std::string_view bytes, std::string_view name, const I
   } else {
     ByteStream stream(data, true, data_name);
     std::vector<char> skip(4096);
-    for (std::int64_t left = byte_skip; left > 0;) {
+    // (Skip: nothing is inflated, not even the skipped bytes.)
+    for (std::int64_t left = options.samples == ImageSamples::Skip ? 0 : byte_skip; left > 0;) {
       const std::size_t want = std::size_t(std::min<std::int64_t>(left, 4096));
       if (stream.read(skip.data(), want) < want)
         throw Error(ErrorCode::Truncated, at_byte(data_name, stream.position()) + " (decompressed)", "byte skip runs past the data");

@@ -5,9 +5,12 @@
 //             attraction = 2  tolerance = 0.1  steps = N | time = T  max_time = 0  voxel_size = 0
 //             reference_threshold = T (Dice against the component of {I > T} holding the seeds) }
 // Outputs: STEM.lsg, STEM.ply, the stats (image, steps, convergence, measures, Dice).
+#include <algorithm>
+
 #include "apps/image_regions.hpp"
 #include "apps/segmentation.hpp"
 #include "core/error.hpp"
+#include "core/memory_budget.hpp"
 #include "io/image_reader.hpp"
 #include "jobs/applications.hpp"
 
@@ -49,6 +52,31 @@ void run_segment_job(JobContext& ctx) {
     ctx.log(line);
   };
 
+  // The header first: reading, downsampling and segmenting are checked against the memory
+  // budget before a single sample is inflated.
+  {
+    ImageReadOptions header_only;
+    header_only.samples = ImageSamples::Skip;
+    const ImageReadResult header = read_image(path, header_only);
+    const ImageVolume& full = header.image;
+    ImageVolume work = full;  // the image segment_image sees (dimensions only)
+    if (factor > 1 && factor <= full.nx && factor <= full.ny && factor <= full.nz) {
+      work.nx = full.nx / factor;
+      work.ny = full.ny / factor;
+      work.nz = full.nz / factor;
+      work.spacing = full.spacing * double(factor);
+    }
+    const std::uint64_t full_bytes = full.voxel_count() * sizeof(float);
+    const std::uint64_t work_bytes = work.voxel_count() * sizeof(float);
+    // Reading (the file and the samples), downsampling (both images), then the segmentation.
+    const std::uint64_t read = header.file_bytes + full_bytes;
+    const std::uint64_t down = factor > 1 ? full_bytes + work_bytes : 0;
+    const std::uint64_t segment = work_bytes + apps::segmentation_memory_bytes(work, o);
+    require_within_budget(std::max({read, down, segment}), o.memory_budget, path,
+                          "segmenting a " + std::to_string(full.nx) + " x " + std::to_string(full.ny) + " x " +
+                              std::to_string(full.nz) + " image" +
+                              (factor > 1 ? " downsampled " + std::to_string(factor) + "x" : std::string()));
+  }
   ImageVolume image = read_image(path).image;
   if (factor > 1) image = apps::downsample_image(image, factor, ctx.options().progress);
   ctx.log("input: " + path + " " + std::to_string(image.nx) + "x" + std::to_string(image.ny) + "x" +

@@ -40,8 +40,6 @@ const char* stop_name(const apps::SegmentationResult& r) {
 
 int run_segment(const SegmentArgs& a) {
   const auto t0 = std::chrono::steady_clock::now();
-  const ImageReadResult in = read_image(a.image);
-  const auto t1 = std::chrono::steady_clock::now();
   apps::SegmentationOptions o;
   for (const std::string& text : a.seeds) {
     std::vector<double> s;
@@ -80,6 +78,14 @@ int run_segment(const SegmentArgs& a) {
                    c.volume, c.area, c.motion, (unsigned long long)c.active_voxels);
       std::fflush(out);
     };
+  // The header first: what the segmentation will allocate is checked against the memory
+  // budget before a single sample is inflated.
+  ImageReadOptions header_only;
+  header_only.samples = ImageSamples::Skip;
+  const ImageReadResult header = read_image(a.image, header_only);
+  apps::require_segmentation_budget(header.image, header.file_bytes, o, a.image);
+  const ImageReadResult in = read_image(a.image);
+  const auto t1 = std::chrono::steady_clock::now();
   const apps::SegmentationResult r = apps::segment_image(in.image, o);
   const auto t2 = std::chrono::steady_clock::now();
   const LsgWriteResult written = save_lsg(r.band, a.output);

@@ -738,6 +738,8 @@ TEST(LsgFileRefuse, HugeCountsInATinyFileFailFastWithoutAllocating) {
   LsgReadOptions lifted;
   lifted.max_active_voxels = std::numeric_limits<std::uint64_t>::max();
   lifted.max_raw_bytes = std::numeric_limits<std::uint64_t>::max();
+  lifted.max_compression_ratio = std::numeric_limits<double>::infinity();
+  lifted.memory_budget = std::numeric_limits<std::uint64_t>::max();
   EXPECT_TRUE(refused(file, ErrorCode::Corrupt, std::nullopt, lifted));
   // Bricks beyond 2^32 (with a raw size that does not overflow either way).
   Header hb = header_of(r, 0, stored.size());
