@@ -88,7 +88,7 @@ void run_evolve_job(JobContext& ctx) {
           std::string(evolve::to_string(result.stop)) + ")");
   ctx.write_band(result.band);
   ctx.write_surface(result.band);
-  if (result.stop == evolve::StopReason::NonFinite) throw Error(ErrorCode::NonFinite, "evolve", result.message);
+  evolve::throw_if_stopped(result, "evolve");  // cancelled or non-finite: no result
 }
 
 }  // namespace levelset::jobs

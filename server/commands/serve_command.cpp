@@ -41,6 +41,8 @@ int serve(ServeArgs& a) {
   sigaddset(&signals, SIGTERM);
   pthread_sigmask(SIG_BLOCK, &signals, nullptr);
   std::signal(SIGPIPE, SIG_IGN);
+  // A file-size limit (ulimit -f) makes writes fail with EFBIG (a 507 for the job), not kill us.
+  std::signal(SIGXFSZ, SIG_IGN);
   // A long-running daemon keeps no list of the files it touched (the batch CLI's guard).
   enable_output_guard(false);
 

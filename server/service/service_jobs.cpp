@@ -1,11 +1,13 @@
 // Service: submitting, running, cancelling, stopping and resuming jobs.
 #include <chrono>
+#include <map>
 #include <system_error>
 
 #include "config/config_file.hpp"
 #include "core/error.hpp"
 #include "core/file_io.hpp"
 #include "grid/lsg_file.hpp"
+#include "evolve/speed.hpp"
 #include "jobs/job.hpp"
 #include "service/api_error.hpp"
 #include "service/ids.hpp"
@@ -23,6 +25,25 @@ std::shared_ptr<Job> Service::make_job(const json& request, const std::string& s
   return std::make_shared<Job>(id, request, session_id, data_ / "jobs" / (id + ".json"));
 }
 
+namespace {
+
+// A speed formula is compiled when the job is submitted, so a typo is a 400 with its column
+// now, not a failed job later.
+void check_formula(const json& body) {
+  if (body.value("op", "") != "evolve" || !body.contains("speed") || !body["speed"].is_string()) return;
+  std::map<std::string, double, std::less<>> constants;
+  if (body.contains("constants") && body["constants"].is_object())
+    for (const auto& [k, v] : body["constants"].items())
+      if (v.is_number()) constants[k] = v.get<double>();
+  try {
+    (void)evolve::speed_from_text(body["speed"].get<std::string>(), body.value("c", 1.0), body.value("eps", 0.1), constants);
+  } catch (const Error& e) {
+    throw ApiError::from_error(Error(e.code(), "body.speed (" + e.where() + ")", e.reason()));
+  }
+}
+
+}  // namespace
+
 Reply Service::submit(const std::string& session_id, const json& body) {
   if (!body.is_object()) throw bad_request("expected a JSON object");
   if (!body.contains("op") || !body["op"].is_string()) throw bad_request("the body needs \"op\" (GET /api/v1 lists the operations)");
@@ -36,6 +57,7 @@ Reply Service::submit(const std::string& session_id, const json& body) {
   } else if (op->kind != OperationInfo::Creates) {
     throw unprocessable("body.op", "'" + op->name + "' works on a session: POST /api/v1/sessions/{id}/jobs");
   }
+  check_formula(body);
   auto job = make_job(body, session_id);
   // The session is claimed at submission (a second job gets 409 at once), or, with
   // "queue": true, by the worker when the running job has ended.
@@ -336,7 +358,12 @@ void Service::run_job(Job& job) {
       }
     }
     if (session) sessions_->drop_checkpoint(*session, job.id());
-    job.set_progress({{"fraction", 1.0}, {"stage", "done"}});
+    json done = {{"fraction", 1.0}, {"stage", "done"}};
+    if (result.contains("evolution")) {  // the exact end (step progress is published throttled)
+      done["step"] = result["evolution"].value("steps", 0) + checkpoint_base.value("steps", 0);
+      done["time"] = result["evolution"].value("time", 0.0) + checkpoint_base.value("time", 0.0);
+    }
+    job.set_progress(done);
     job.set_state(JobState::Succeeded,
                   {{"result", result}, {"seconds", std::chrono::duration<double>(Clock::now() - started).count()}});
     ++jobs_succeeded_;
@@ -345,11 +372,16 @@ void Service::run_job(Job& job) {
       job.set_state(job.shutting_down ? JobState::Interrupted : JobState::Cancelled,
                     {{"reason", job.shutting_down ? "the server shut down" : "cancelled on request"}});
     } else {
-      job.set_state(JobState::Failed, {{"error", ApiError::from_error(e).body()["error"]}});
+      const ApiError api = ApiError::from_error(e);
+      json error = api.body()["error"];
+      error["status"] = api.status();
+      job.set_state(JobState::Failed, {{"error", error}});
       ++jobs_failed_;
     }
   } catch (const ApiError& e) {
-    job.set_state(JobState::Failed, {{"error", e.body()["error"]}});
+    json error = e.body()["error"];
+    error["status"] = e.status();
+    job.set_state(JobState::Failed, {{"error", error}});
     ++jobs_failed_;
   } catch (const std::exception& e) {
     job.set_state(JobState::Failed, {{"error", {{"code", "internal"}, {"message", e.what()}, {"details", json::object()}}}});

@@ -116,6 +116,12 @@ std::vector<std::string> SessionStore::load_all() {
   for (const fs::directory_entry& d : fs::directory_iterator(dir_, ec)) {
     const std::string id = d.path().filename().string();
     if (!d.is_directory() || !is_valid_id(id, 's')) continue;
+    // A directory without session.json is a creation cut short (kill -9 between mkdir and the
+    // first metadata write): no client was ever told of it.
+    if (!fs::exists(d.path() / "session.json", ec)) {
+      fs::remove_all(d.path(), ec);
+      continue;
+    }
     try {
       json meta = read_json(d.path() / "session.json");
       const std::string band_file = meta.value("band_file", "");

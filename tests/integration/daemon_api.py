@@ -1,0 +1,481 @@
+#!/usr/bin/python3
+"""The daemon over real HTTP (issue 15): a real `levelsetd serve` on a free loopback port.
+
+Usage: daemon_api.py LEVELSETD SCRATCH_DIR CGAL_DATA TEST
+TEST is one of the functions below named test_<TEST>; each is its own ctest.
+"""
+import concurrent.futures
+import json
+import os
+import random
+import resource
+import shutil
+import subprocess
+import sys
+import threading
+import time
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from daemon_harness import Daemon, off_topology, upload  # noqa: E402
+
+BIN, SCRATCH, CGAL = sys.argv[1], sys.argv[2], sys.argv[3]
+TOKEN_RW, TOKEN_RO = "rw-token-0123456789abcdef", "ro-token-0123456789abcdef"
+
+
+def check(cond, what):
+    if not cond:
+        raise AssertionError(what)
+
+
+def fresh(name):
+    d = os.path.join(SCRATCH, name)
+    shutil.rmtree(d, ignore_errors=True)
+    if os.path.exists(d + ".log"):
+        os.remove(d + ".log")
+    os.makedirs(os.path.dirname(d), exist_ok=True)
+    return d
+
+
+def healthy(d):
+    status, _, body = d.get("/healthz")
+    check(status == 200 and body["status"] == "ok", f"/healthz after a refusal: {status} {body}")
+
+
+def sphere_session(d, resolution=48, name="s"):
+    status, _, s = d.post("/api/v1/sessions", {"primitive": "sphere", "raster": {"resolution": resolution}, "name": name})
+    check(status == 201, f"create session: {status} {s}")
+    return s
+
+
+def long_evolve(d, session_id, steps=100000, speed="1"):
+    status, hdrs, job = d.post(f"/api/v1/sessions/{session_id}/jobs",
+                               {"op": "evolve", "speed": speed, "steps": steps, "report_every": 0})
+    check(status == 202 and hdrs.get("Location") == f"/api/v1/jobs/{job['id']}", f"submit: {status} {job}")
+    return job
+
+
+def wait_running(d, job_id, min_step=1, timeout=60):
+    t0 = time.monotonic()
+    while time.monotonic() - t0 < timeout:
+        job = d.get(f"/api/v1/jobs/{job_id}")[2]
+        if job["state"] == "running" and job["progress"].get("step", 0) >= min_step:
+            return job
+        if job["state"] not in ("queued", "running"):
+            raise AssertionError(f"job ended early: {job}")
+        d.events(f"/api/v1/jobs/{job_id}/events", until=lambda e: e[1] == "progress" and e[2].get("step", 0) >= min_step,
+                 timeout=timeout)
+    raise AssertionError("job never ran")
+
+
+# ---- the API surface ---------------------------------------------------------------------------
+
+def test_surface():
+    d = Daemon(BIN, fresh("surface"))
+    try:
+        status, _, info = d.get("/api/v1")
+        check(status == 200 and info["api"] == "v1" and info["limits"]["max_jobs"] >= 1, f"/api/v1: {info}")
+        check({o["op"] for o in info["operations"]} >= {"evolve", "redistance", "offset", "fair", "minmax", "csg",
+                                                       "reconstruct", "segment", "cpt", "mesh", "measure"},
+              "operations listed")
+        check(d.get("/readyz")[0] == 200, "readyz")
+        status, hdrs, metrics = d.request("GET", "/metrics")
+        check(status == 200 and b"# TYPE levelset_requests_total counter" in metrics, "metrics")
+        status, hdrs, _ = d.request("GET", "/healthz")
+        check(len(hdrs.get("X-Request-Id", "")) > 0, "X-Request-Id")
+        status, hdrs, _ = d.request("GET", "/healthz", headers={"X-Request-Id": "my-request-1"})
+        check(hdrs.get("X-Request-Id") == "my-request-1", "the client's request id is kept")
+        # Every documented route is registered (none answers "no_route"), and nothing else is.
+        status, _, doc = d.get("/api/v1/openapi.json")
+        check(status == 200 and doc["openapi"].startswith("3.0"), "openapi document")
+        documented = 0
+        for path, methods in doc["paths"].items():
+            concrete = path
+            for name in ("{id}", "{jid}", "{sid}", "{name}"):
+                concrete = concrete.replace(name, "x-s-0000000000000000")
+            for method in methods:
+                if path.endswith("/events"):
+                    continue  # a stream of an unknown id: 404 not_found below is enough
+                st, _, body = d.json_request(method.upper(), concrete, {} if method in ("post", "patch") else None)
+                code = body.get("error", {}).get("code") if isinstance(body, dict) else None
+                check(code != "no_route", f"{method.upper()} {path} is documented but not registered")
+                documented += 1
+        check(documented >= 25, f"only {documented} routes documented")
+        st, _, body = d.get("/api/v1/nothing-here")
+        check(st == 404 and body["error"]["code"] == "no_route", "an unknown route is a JSON 404 no_route")
+        st, _, body = d.get("/api/v1/sessions/x-s-0000000000000000/events")
+        check(st == 404 and body["error"]["code"] == "not_found", "events of an unknown session")
+    finally:
+        d.stop()
+
+
+# ---- end to end ---------------------------------------------------------------------------------
+
+def batch_genus(points, resolution, workdir):
+    """The batch run's genus, for comparison with the served one."""
+    mesh = os.path.join(workdir, "batch.off")
+    subprocess.run([BIN, "reconstruct", points, "--resolution", str(resolution), "-o", mesh], check=True,
+                   capture_output=True)
+    with open(mesh) as f:
+        return off_topology(f.read())
+
+
+def test_reconstruct_kitten():
+    work = fresh("kitten")
+    d = Daemon(BIN, work)
+    try:
+        points = os.path.join(CGAL, "points_3", "kitten.xyz")
+        status, hdrs, up = upload(d, points, "xyz")
+        check(status == 201 and up["kind"] == "points" and up["summary"]["points"] > 5000, f"upload: {status} {up}")
+        status, _, job = d.post("/api/v1/sessions", {"upload": up["id"], "name": "kitten", "raster": {"resolution": 64}})
+        check(status == 202, f"create from points: {status} {job}")
+        events = d.events(f"/api/v1/jobs/{job['id']}/events", until=lambda e: e[1] == "done", timeout=300)
+        types = [e[1] for e in events]
+        check(types[0] == "state" and types[-1] == "done" and "log" in types, f"event stream: {types[:10]}...")
+        check(all(events[i][0] < events[i + 1][0] for i in range(1, len(events) - 1)), "event ids increase")
+        final = d.get(f"/api/v1/jobs/{job['id']}")[2]
+        check(final["state"] == "succeeded", f"job: {final}")
+        sid = final["result"]["session"]
+        status, hdrs, mesh = d.request("GET", f"/api/v1/sessions/{sid}/mesh?format=off")
+        check(status == 200 and hdrs.get("ETag"), "mesh download with an ETag")
+        served = off_topology(mesh.decode())
+        batch = batch_genus(points, 64, os.path.dirname(work))
+        check(served[2], f"the served mesh is not watertight: {served}")
+        check(served[3] == batch[3] and served[4] == batch[4], f"genus/components served {served} vs batch {batch}")
+        status, _, _ = d.request("GET", f"/api/v1/sessions/{sid}/mesh?format=off", headers={"If-None-Match": hdrs["ETag"]})
+        check(status == 304, f"If-None-Match gives 304, got {status}")
+        status, _, band = d.request("GET", f"/api/v1/sessions/{sid}/band")
+        check(status == 200 and len(band) > 1000, "band download")
+        status, hdrs, recs = d.request("GET", f"/api/v1/sessions/{sid}/voxels?min=-0.001&max=0.001&fields=value,closest,curvature&limit=100")
+        check(status == 200 and hdrs.get("X-Fields") == "x,y,z,value,cx,cy,cz,curvature", f"voxels: {hdrs}")
+        check(len(recs) == 32 * min(100, int(hdrs["X-Total-Count"])), f"voxel records: {len(recs)} bytes")
+    finally:
+        d.stop()
+
+
+def test_knot_job_file():
+    """A job file over the API: the shipped knot reconstruction, its final band a session."""
+    d = Daemon(BIN, fresh("knotjob"))
+    try:
+        with open(os.path.join(os.path.dirname(__file__), "..", "..", "configs", "jobs", "reconstruct_knot.conf")) as f:
+            text = f.read()
+        status, _, job = d.post("/api/v1/jobs", {"config": text, "name": "reconstruct_knot.conf",
+                                                 "set": ["raster.resolution=64", "input.count=8000"]})
+        check(status == 202, f"job file: {status} {job}")
+        final = d.wait_job(job["id"])
+        check(final["state"] == "succeeded", f"job: {final}")
+        check("reconstruct_knot.ply" in final["result"]["files"], f"files: {final['result']['files']}")
+        sid = final["result"]["session"]
+        served = off_topology(d.request("GET", f"/api/v1/sessions/{sid}/mesh?format=off")[2].decode())
+        check(served[2] and served[3] == 1 and served[4] == 1, f"the knot: watertight genus 1: {served}")
+        status, _, ply = d.request("GET", f"/api/v1/jobs/{job['id']}/files/reconstruct_knot.ply")
+        check(status == 200 and ply.startswith(b"ply"), "the job's mesh file")
+        status, _, body = d.post("/api/v1/jobs", {"config": "job = offset\ninput { shape = knot\n", "name": "bad.conf"})
+        check(status == 400 and "bad.conf:" in body["error"]["message"], f"a malformed job file: {status} {body}")
+        status, _, body = d.post("/api/v1/jobs", {"config": "job = offset\ninput { mesh = ../../etc/passwd }\n"
+                                                            "offset { distance = 0.1 }\n"})
+        final = d.wait_job(body["id"])
+        check(final["state"] == "failed" and "leaves" in final["error"]["message"], f"a path outside: {final}")
+    finally:
+        d.stop()
+
+
+# ---- cancel, stop, restart ------------------------------------------------------------------
+
+def test_cancel_and_stop():
+    d = Daemon(BIN, fresh("cancelstop"))
+    try:
+        s = sphere_session(d)
+        before = d.request("GET", f"/api/v1/sessions/{s['id']}/band")[2]
+        job = long_evolve(d, s["id"])
+        wait_running(d, job["id"], 5)
+        status, _, _ = d.json_request("DELETE", f"/api/v1/jobs/{job['id']}")
+        check(status == 200, "cancel")
+        final = d.wait_job(job["id"])
+        check(final["state"] == "cancelled", f"cancelled: {final['state']}")
+        now = d.get(f"/api/v1/sessions/{s['id']}")[2]
+        check(now["version"] == 1 and d.request("GET", f"/api/v1/sessions/{s['id']}/band")[2] == before,
+              "cancel keeps the old state")
+        job = long_evolve(d, s["id"])
+        reached = wait_running(d, job["id"], 20)["progress"]["step"]
+        status, _, _ = d.post(f"/api/v1/jobs/{job['id']}/stop")
+        check(status == 200, "stop")
+        final = d.wait_job(job["id"])
+        check(final["state"] == "succeeded" and final["result"]["stopped"], f"stopped: {final}")
+        steps = final["result"]["evolution"]["steps"]
+        check(reached <= steps < 100000, f"stop kept the state reached ({steps} steps, >= {reached})")
+        now = d.get(f"/api/v1/sessions/{s['id']}")[2]
+        check(now["version"] == 2 and now["band"]["bounds"]["max"][0] > s["band"]["bounds"]["max"][0],
+              "stop keeps the new state (the sphere grew)")
+        # Stop of a job without steps is refused.
+        j = d.post(f"/api/v1/sessions/{s['id']}/jobs", {"op": "measure"})[2]
+        d.wait_job(j["id"])
+        status, _, body = d.post(f"/api/v1/jobs/{j['id']}/stop")
+        check(status == 409, f"stop of a measure: {status} {body}")
+    finally:
+        d.stop()
+
+
+def test_restart_and_resume():
+    data = fresh("restart")
+    d = Daemon(BIN, data, "--checkpoint-seconds", "0.3")
+    s = sphere_session(d, 64)
+    d.post(f"/api/v1/sessions/{s['id']}/snapshots", {"name": "start"})
+    # Mean curvature flow: bounded work per step (the sphere shrinks; it vanishes after ~2300).
+    job = long_evolve(d, s["id"], steps=1000, speed="-(k1+k2)")
+    wait_running(d, job["id"], 30)
+    # A checkpoint lands within checkpoint_seconds; then kill -9 mid-job.
+    ckpt = os.path.join(data, "sessions", s["id"], f"checkpoint-{job['id']}.json")
+    t0 = time.monotonic()
+    while not os.path.exists(ckpt) and time.monotonic() - t0 < 30:
+        d.events(f"/api/v1/jobs/{job['id']}/events", until=lambda e: e[1] == "progress", timeout=10)
+    check(os.path.exists(ckpt), "no checkpoint written")
+    d.kill()
+    d = Daemon(BIN, data)
+    try:
+        sessions = d.get("/api/v1/sessions")[2]["sessions"]
+        check([x["id"] for x in sessions] == [s["id"]] and sessions[0]["version"] == 1, f"sessions back: {sessions}")
+        check(sessions[0]["snapshots"] == 1, "snapshots back")
+        j = d.get(f"/api/v1/jobs/{job['id']}")[2]
+        check(j["state"] == "interrupted", f"a job cut off by kill -9 is interrupted: {j['state']}")
+        status, _, _ = d.post(f"/api/v1/jobs/{job['id']}/resume")
+        check(status == 202, "resume")
+        # Last-Event-ID: 0 replays the resumed job's events from its first.
+        events = d.events(f"/api/v1/jobs/{job['id']}/events", until=lambda e: e[1] == "done", timeout=300,
+                          headers={"Last-Event-ID": "0"})
+        resumed = [e for e in events if e[1] == "log" and "resumed from the checkpoint" in e[2]["line"]]
+        check(resumed, "resumed from the checkpoint")
+        final = d.get(f"/api/v1/jobs/{job['id']}")[2]
+        check(final["state"] == "succeeded", f"resume completes: {final['state']} {final.get('error')}")
+        check(final["progress"]["step"] == 1000, f"the resumed job ends at the requested step: {final['progress']}")
+        check(d.get(f"/api/v1/sessions/{s['id']}")[2]["version"] == 2, "the resumed job committed")
+    finally:
+        d.stop()
+
+
+def test_sigterm_during_job():
+    data = fresh("sigterm")
+    d = Daemon(BIN, data, "--shutdown-deadline", "10")
+    s = sphere_session(d, 64)
+    job = long_evolve(d, s["id"], steps=100000, speed="-(k1+k2)")
+    wait_running(d, job["id"], 10)
+    rc, seconds = d.stop()
+    check(rc == 0 and seconds < 10, f"SIGTERM: exit {rc} after {seconds:.2f} s")
+    d = Daemon(BIN, data)
+    try:
+        j = d.get(f"/api/v1/jobs/{job['id']}")[2]
+        check(j["state"] == "interrupted", f"job after SIGTERM: {j['state']}")
+        check(os.path.exists(os.path.join(data, "sessions", s["id"], f"checkpoint-{job['id']}.lsg")),
+              "SIGTERM checkpointed the job")
+    finally:
+        d.stop()
+
+
+def test_kill9_storm():
+    """20 kill -9 at random moments during uploads and jobs; every session still loads."""
+    data = fresh("storm")
+    rng = random.Random(14)
+    points = os.path.join(CGAL, "points_3", "kitten.xyz")
+    mesh = os.path.join(CGAL, "meshes", "knot1.off")
+    for round_ in range(20):
+        d = Daemon(BIN, data, "--checkpoint-seconds", "0.05")
+        log = d.read_log()
+        check("not loaded" not in log, f"round {round_}: a session did not load: {log[-1500:]}")
+        sessions = d.get("/api/v1/sessions")[2]["sessions"]
+        for s in sessions:
+            status, _, band = d.request("GET", f"/api/v1/sessions/{s['id']}/band")
+            check(status == 200 and len(band) > 100, f"round {round_}: session {s['id']} band: {status}")
+        def activity():
+            try:
+                s = sphere_session(d, 32)
+                upload(d, points if round_ % 2 else mesh, "xyz" if round_ % 2 else "off")
+                d.post(f"/api/v1/sessions/{s['id']}/jobs", {"op": "evolve", "speed": "-(k1+k2)", "steps": 400})
+                d.post(f"/api/v1/sessions/{s['id']}/snapshots", {})
+            except Exception:
+                pass  # the kill may land mid-request
+        t = threading.Thread(target=activity)
+        t.start()
+        time.sleep(rng.uniform(0.0, 0.4))
+        d.kill()
+        t.join()
+    d = Daemon(BIN, data)
+    try:
+        check("not loaded" not in d.read_log(), "after the storm every session loads")
+        leftovers = [f for root, _, files in os.walk(data) for f in files if ".tmp-" in f]
+        check(not leftovers, f"temp files under final names' directories: {leftovers[:5]}")
+    finally:
+        d.stop()
+
+
+def test_write_failure():
+    """A write that fails (file size limit) fails the job with 507 and keeps the last version."""
+    data = fresh("efbig")
+    limit = 64 * 1024
+
+    def small_files():
+        resource.setrlimit(resource.RLIMIT_FSIZE, (limit, limit))
+
+    d = Daemon(BIN, data, preexec_fn=small_files)
+    try:
+        s = sphere_session(d, 48)  # ~50 KB band
+        status, _, job = d.post(f"/api/v1/sessions/{s['id']}/jobs", {"op": "offset", "distance": 0.6})
+        final = d.wait_job(job["id"])
+        check(final["state"] == "failed" and final["error"]["status"] == 507, f"job on a full disk: {final}")
+        now = d.get(f"/api/v1/sessions/{s['id']}")[2]
+        check(now["version"] == 1, "the last version stays")
+        healthy(d)
+    finally:
+        d.stop()
+    d = Daemon(BIN, data)
+    try:
+        sessions = d.get("/api/v1/sessions")[2]["sessions"]
+        check(len(sessions) == 1 and sessions[0]["version"] == 1, "the session loads after the failed write")
+    finally:
+        d.stop()
+
+
+# ---- refusals -------------------------------------------------------------------------------
+
+def test_refusals():
+    d = Daemon(BIN, fresh("refusals"), "--tokens", f"{TOKEN_RW},{TOKEN_RO}:ro", "--max-body-bytes", "2K",
+               "--max-session-voxels", "20000", "--max-jobs", "1", "--max-queued-jobs", "1")
+    rw = {"Authorization": "Bearer " + TOKEN_RW}
+    ro = {"Authorization": "Bearer " + TOKEN_RO}
+    try:
+        status, hdrs, body = d.get("/api/v1/sessions")
+        check(status == 401 and "Bearer" in hdrs.get("WWW-Authenticate", ""), f"no token: {status}")
+        healthy(d)
+        status, _, _ = d.get("/api/v1/sessions", headers={"Authorization": "Bearer wrong-token-0123456789"})
+        check(status == 401, "a wrong token")
+        check(d.get("/api/v1/sessions", headers=ro)[0] == 200, "read-only token on a GET")
+        status, _, body = d.post("/api/v1/sessions", {"primitive": "sphere"}, headers=ro)
+        check(status == 403 and body["error"]["code"] == "forbidden", f"read-only token on a POST: {status}")
+        healthy(d)
+        status, _, body = d.post("/api/v1/sessions", {"primitive": "sphere", "pad": "x" * 4000}, headers=rw)
+        check(status == 413, f"oversized body: {status} {body}")
+        healthy(d)
+        status, _, body = d.json_request("POST", "/api/v1/sessions", '{"primitive":\n "sphere",,}', headers=rw)
+        check(status == 400 and body["error"]["details"]["line"] == 2, f"malformed JSON: {status} {body}")
+        healthy(d)
+        status, _, body = d.post("/api/v1/sessions", {"primitive": "sphere", "raster": {"resolution": 16}}, headers=rw)
+        check(status == 201, f"small session: {status} {body}")
+        sid = body["id"]
+        status, _, body = d.post(f"/api/v1/sessions/{sid}/jobs", {"op": "evolve", "speed": "1 + * k1", "steps": 2},
+                                 headers=rw)
+        check(status == 400 and "column" in body["error"]["message"], f"formula error: {status} {body}")
+        healthy(d)
+        bad = os.path.join(SCRATCH, "bad.off")
+        with open(bad, "w") as f:
+            f.write("OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 7\n")
+        status, _, body = upload(d, bad, "off", headers=rw)
+        check(status == 400 and ":6" in body["error"]["message"], f"malformed mesh: {status} {body}")
+        healthy(d)
+        status, _, body = d.get("/api/v1/sessions/x-s-0123456789abcdef", headers=ro)
+        check(status == 404, f"unknown session: {status}")
+        status, _, body = d.post(f"/api/v1/sessions/{sid}/jobs", {"op": "evolve", "speed": "1", "steps": -3},
+                                 headers=rw)
+        final = d.wait_job(body["id"], headers=ro) if status == 202 else None
+        check(status == 422 or (final and final["state"] == "failed" and final["error"]["status"] == 422),
+              f"a parameter out of range: {status} {body} {final}")
+        status, _, body = d.post("/api/v1/sessions", {"primitive": "sphere", "raster": {"resolution": 64}}, headers=rw)
+        check(status == 507 and "max_session_voxels" in body["error"]["message"], f"voxel budget: {status} {body}")
+        healthy(d)
+        # Busy session and full queue.
+        a = d.post("/api/v1/sessions", {"primitive": "sphere", "raster": {"resolution": 16}}, headers=rw)[2]["id"]
+        b = d.post("/api/v1/sessions", {"primitive": "sphere", "raster": {"resolution": 16}}, headers=rw)[2]["id"]
+        c = d.post("/api/v1/sessions", {"primitive": "sphere", "raster": {"resolution": 16}}, headers=rw)[2]["id"]
+        long_job = d.post(f"/api/v1/sessions/{a}/jobs", {"op": "evolve", "speed": "0.01", "steps": 10 ** 7,
+                                                        "report_every": 0}, headers=rw)[2]
+        status, _, body = d.post(f"/api/v1/sessions/{a}/jobs", {"op": "measure"}, headers=rw)
+        check(status == 409, f"busy session: {status} {body}")
+        status, _, queued = d.post(f"/api/v1/sessions/{b}/jobs", {"op": "measure"}, headers=rw)
+        check(status == 202, f"queued: {status}")
+        status, _, body = d.post(f"/api/v1/sessions/{c}/jobs", {"op": "measure"}, headers=rw)
+        check(status == 429, f"full queue: {status} {body}")
+        healthy(d)
+        # Idempotency: a retried POST returns the first answer.
+        key = {"Idempotency-Key": "retry-1", **rw}
+        first = d.post(f"/api/v1/sessions/{c}/snapshots", {"name": "once"}, headers=key)
+        again = d.post(f"/api/v1/sessions/{c}/snapshots", {"name": "once"}, headers=key)
+        check(first[0] == 201 and again[2] == first[2] and again[1].get("Idempotent-Replayed") == "true",
+              "idempotent replay")
+        check(len(d.get(f"/api/v1/sessions/{c}/snapshots", headers=ro)[2]["snapshots"]) == 1, "one snapshot")
+        d.json_request("DELETE", f"/api/v1/jobs/{long_job['id']}", headers=rw)
+        check(d.wait_job(queued["id"], headers=ro)["state"] == "succeeded", "the queued job ran after the cancel")
+        healthy(d)
+    finally:
+        d.stop()
+
+
+def test_security_defaults():
+    out = subprocess.run([BIN, "serve", "--host", "0.0.0.0", "--port", "0", "--data", fresh("insecure")],
+                         capture_output=True, text=True, timeout=20)
+    check(out.returncode != 0 and "token" in out.stderr, f"beyond loopback without tokens: {out.returncode} {out.stderr}")
+    check(subprocess.run([BIN, "serve", "--help"], capture_output=True, text=True).stdout.count("LEVELSET_") >= 20,
+          "serve --help lists the settings and their variables")
+    conf = os.path.join(os.path.dirname(__file__), "..", "..", "configs", "server.conf")
+    text = open(conf).read()
+    help_text = subprocess.run([BIN, "serve", "--help"], capture_output=True, text=True).stdout
+    import re
+    for env in re.findall(r"\[LEVELSET_([A-Z_]+)\]", help_text):
+        key = env.lower()
+        check(re.search(rf"^(// )?{key} =", text, re.M), f"configs/server.conf does not document '{key}'")
+    d = Daemon(BIN, fresh("conf"), "--config", conf, env={"LEVELSET_MAX_SESSIONS": "7"})
+    try:
+        check(d.get("/api/v1")[2]["limits"]["max_sessions"] == 7, "the environment overrides the file")
+    finally:
+        d.stop()
+    d = Daemon(BIN, fresh("conf2"), "--config", conf, "--max-sessions", "9", env={"LEVELSET_MAX_SESSIONS": "7"})
+    try:
+        check(d.get("/api/v1")[2]["limits"]["max_sessions"] == 9, "flags override the environment")
+    finally:
+        d.stop()
+
+
+def test_concurrency():
+    """64 clients creating sessions, submitting jobs, polling and holding event streams."""
+    d = Daemon(BIN, fresh("concurrency"), "--max-queued-jobs", "256")
+    errors = []
+
+    def client(i):
+        try:
+            status, _, s = d.post("/api/v1/sessions", {"primitive": "sphere", "raster": {"resolution": 16}})
+            if status != 201:
+                return f"create {status}"
+            status, _, job = d.post(f"/api/v1/sessions/{s['id']}/jobs", {"op": "redistance"})
+            if status != 202:
+                return f"submit {status} {job}"
+            if i % 2:
+                final = d.wait_job(job["id"], timeout=300)
+            else:
+                for _ in range(200):
+                    final = d.get(f"/api/v1/jobs/{job['id']}")[2]
+                    if final["state"] not in ("queued", "running"):
+                        break
+                    d.events(f"/api/v1/jobs/{job['id']}/events", until=lambda e: e[1] == "done", timeout=60)
+            if final["state"] != "succeeded":
+                return f"job {final['state']}"
+            for _ in range(5):
+                if d.get(f"/api/v1/sessions/{s['id']}")[0] != 200:
+                    return "poll"
+            return None
+        except Exception as e:  # noqa: BLE001
+            return repr(e)
+
+    try:
+        with concurrent.futures.ThreadPoolExecutor(64) as pool:
+            results = list(pool.map(client, range(64)))
+        errors = [r for r in results if r]
+        check(not errors, f"{len(errors)} clients failed: {errors[:5]}")
+        status, _, m = d.request("GET", "/metrics")
+        check(b"levelset_sessions 64" in m, "64 sessions counted")
+        healthy(d)
+    finally:
+        d.stop()
+
+
+if __name__ == "__main__":
+    name = sys.argv[4]
+    os.makedirs(SCRATCH, exist_ok=True)
+    t0 = time.monotonic()
+    globals()["test_" + name]()
+    print(f"daemon_api {name}: passed in {time.monotonic() - t0:.1f} s")
