@@ -9,6 +9,12 @@
 //   point' display and for extension velocities. The sign is the inside mask's at every voxel,
 //   also exactly on the surface (compute_inside_masks' convention): an inside voxel at
 //   distance 0 holds -FLT_MIN, never -0, so value < 0 is exactly the winding-number inside.
+//   Open meshes (open edges: holes, borders, inconsistent regions): the sign also changes where
+//   w crosses 1/2 away from the mesh, across each hole (its membrane); those voxels and all
+//   within W*h of them are in the band too, valued sign * min(distance to the mesh, distance
+//   to the membrane) (close_membranes, membrane_band.hpp), so the zero level is closed and the
+//   band invariant holds; closest points there are the nearest membrane points (estimated).
+//   Closed meshes are untouched by this (bit for bit).
 // Method: (thesis 2.3.4, 4.5) triangles are binned to the bricks they come within W*h of;
 //   each brick then scan-converts its triangles' slabs (|plane distance| <= W*h, per column of
 //   the dominant axis) and keeps the minimum exact point-triangle distance per voxel (ties:
@@ -16,7 +22,8 @@
 //   consistently (orient_faces), then every voxel of every brick gets the generalized winding
 //   number test (> 1/2 is inside) from one hierarchical evaluation per brick plus signed
 //   crossings along grid edges (compute_inside_masks) — robust for holes, open boundaries,
-//   self-intersections and flipped faces (thesis open issue 5.3).
+//   self-intersections and flipped faces (thesis open issue 5.3). Then, for open meshes only,
+//   the membranes (membrane_band.hpp).
 // Cost: O(triangles * bricks per triangle + band voxels * triangles per voxel slab).
 // Threading: TBB over triangles and bricks; bit-identical results for any thread count.
 // Errors: Error{InvalidArgument} for an empty mesh or bad indices, Error{NonFinite} for NaN or

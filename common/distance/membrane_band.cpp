@@ -382,8 +382,10 @@ class Membranes {
               const float dmm = dmesh[std::size_t(d2) * kBrickVoxels + std::size_t(m)];
               if (dm[n] <= threshold_ && dmm <= threshold_ - dm[n]) continue;  // a mesh edge
               const double wn = wd[n] - 0.5, wm = wv[std::size_t(d2) * kBrickVoxels + std::size_t(m)] - 0.5;
-              double t = 0.5;
-              if ((wn > 0.0) == in && (wm > 0.0) != in && wn != wm) t = wn / (wn - wm);
+              // A query that contradicts the stored sign puts that end on w = 1/2 (within the
+              // tree's error: e.g. an opening's plane through voxel centres).
+              const bool n_ok = (wn > 0.0) == in, m_ok = (wm > 0.0) != in;
+              const double t = n_ok && m_ok ? wn / (wn - wm) : n_ok ? 1.0 : m_ok ? 0.0 : 0.5;
               t_axis = std::min(t_axis, std::clamp(t, 1e-3, 1.0));
             }
             if (t_axis <= 1.0) g2 += 1.0 / (t_axis * t_axis);

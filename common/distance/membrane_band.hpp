@@ -34,8 +34,9 @@
 //      mesh (w is harmonic off the mesh: no closed level surface), so it is reached from the
 //      input's bricks.
 //   3. d_membrane: on membrane voxels, the distance to the plane through the crossings of
-//      w = 1/2 on their membrane edges (linear interpolation of direct w queries; the midpoint
-//      where the query disagrees with the stored sign), as in redistance's interface step;
+//      w = 1/2 on their membrane edges (linear interpolation of direct w queries; an end whose
+//      query contradicts its stored sign counts as lying on w = 1/2, within the tree's error),
+//      as in redistance's interface step;
 //      then fast marching (eikonal_march, first order) out to W voxels.
 // Cost: nothing beyond one pass over the bricks without membrane voxels; otherwise
 //   O(membrane voxels) direct queries plus ~9-80 per added brick, and the march over the bricks

@@ -39,6 +39,12 @@ int run_cpt(const CptArgs& args) {
               args.mesh.c_str(), read.mesh.triangles.size(), cpt.band.active_voxel_count(),
               cpt.band.brick_count(), cpt.band.voxel_size(), std::chrono::duration<double>(t2 - t1).count(),
               args.output.c_str(), human_bytes(written.file_bytes).c_str());
+  if (cpt.open_edges > 0)
+    std::fprintf(summary_stream(args.stats),
+                 "%s: open mesh (%llu open edges): holes closed across %llu membrane voxels (%llu voxels beyond the mesh's band)%s\n",
+                 args.mesh.c_str(), (unsigned long long)cpt.open_edges, (unsigned long long)cpt.membrane_voxels,
+                 (unsigned long long)cpt.membrane_voxels_added,
+                 cpt.membrane_truncated_bricks > 0 ? "; a membrane reaches past the mesh's box and stays open there" : "");
 
   Stats stats("cpt", cpt.band);
   stats.seconds["read"] = secs(t0, t1);
@@ -46,6 +52,7 @@ int run_cpt(const CptArgs& args) {
   stats.seconds["bin"] = cpt.seconds.bin;
   stats.seconds["distance"] = cpt.seconds.distance;
   stats.seconds["sign"] = cpt.seconds.sign;
+  stats.seconds["membrane"] = cpt.seconds.membrane;
   stats.seconds["assemble"] = cpt.seconds.assemble;
   stats.seconds["cpt"] = cpt.seconds.total;
   stats.seconds["write"] = secs(t2, t3);
@@ -57,6 +64,10 @@ int run_cpt(const CptArgs& args) {
   stats.extra["brick_triangle_pairs"] = cpt.brick_triangle_pairs;
   stats.extra["faces_flipped"] = cpt.faces_flipped;
   stats.extra["winding_queries"] = cpt.winding_queries;
+  stats.extra["open_edges"] = cpt.open_edges;
+  stats.extra["membrane_voxels"] = cpt.membrane_voxels;
+  stats.extra["membrane_bricks_added"] = cpt.membrane_bricks_added;
+  stats.extra["membrane_voxels_added"] = cpt.membrane_voxels_added;
   stats.extra["closest_points"] = args.closest_points;
   stats.extra["file_bytes"] = written.file_bytes;
   stats.extra["output"] = args.output;
