@@ -4,7 +4,7 @@ BUILD  := build/$(PRESET)
 OUT    ?= out
 JOBS   ?= $(shell nproc)
 
-.PHONY: all deps configure build run test bench fuzz clean
+.PHONY: all deps configure build run serve test bench fuzz clean
 
 all: build
 
@@ -21,6 +21,10 @@ build: configure
 # the built-in torus knot (no external files); prints the progress and where the outputs went.
 run: build
 	@$(BUILD)/server/levelsetd run configs/jobs/reconstruct_knot.conf -o $(OUT)
+
+# The daemon on its defaults (127.0.0.1:8080, data in $XDG_STATE_HOME/levelset); Ctrl-C stops it.
+serve: build
+	@$(BUILD)/server/levelsetd serve
 
 test: build
 	@cd $(BUILD) && ctest --output-on-failure -j $(JOBS)

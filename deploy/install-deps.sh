@@ -15,7 +15,7 @@ PACKAGES=(
   libcli11-dev nlohmann-json3-dev libfmt-dev
   # the daemon (levelsetd serve) and levelsetctl: HTTP server and client (built with OpenSSL,
   # zlib and brotli; see ../shared/notes/stack.md), logs; curl for the README's walk-through
-  libcpp-httplib-dev libspdlog-dev curl
+  libcpp-httplib-dev libspdlog-dev curl jq
   # mesh I/O reference and later mesh work
   libopenmesh-dev
   # tests and benchmarks (OpenVDB is linked into the benchmark target only)
