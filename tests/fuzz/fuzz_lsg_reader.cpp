@@ -8,6 +8,8 @@
 //      compressed with zstd, the stored-size field and the checksum are patched (the raw-size
 //      field stays as given), so decompression and structure validation see fuzzed content.
 // Only levelset::Error may leave decode_lsg; anything else escapes to the driver as a bug.
+// summarize_lsg (what info reads) must accept exactly the files decode_lsg accepts, and
+// describe them as the decoded band would (memory, bounds).
 #include <cstddef>
 #include <cstdint>
 #include <cstring>
@@ -62,6 +64,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
 
   levelset::LsgReadOptions options;
   options.max_raw_bytes = std::uint64_t{64} << 20;  // keep per-input allocations small
+  options.memory_budget = std::uint64_t{256} << 20;
 
   std::string file;
   if (mode == 0 || input.size() < kHeaderBytes) {
@@ -74,8 +77,19 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     reseal(file);
   }
 
+  // The summary (levelsetd info) refuses exactly what the decode refuses, and agrees on counts.
+  bool summarized = false;
+  levelset::LsgSummary summary;
+  try {
+    summary = levelset::summarize_lsg(file, "fuzz.lsg", options);
+    summarized = true;
+  } catch (const levelset::Error&) {
+  }
   try {
     const levelset::LsgReadResult r = levelset::decode_lsg(file, "fuzz.lsg", options);
+    if (!summarized || summary.header.bricks != r.header.bricks || summary.memory_bytes != r.band.memory_bytes() ||
+        !(summary.active_index_bounds == r.band.active_index_bounds()))
+      __builtin_trap();
     // A file the reader accepts must describe itself consistently and survive a round trip.
     if (r.band.active_voxel_count() != r.header.active_voxels ||
         r.band.brick_count() != r.header.bricks || r.file_bytes != file.size())

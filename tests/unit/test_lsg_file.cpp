@@ -910,5 +910,96 @@ TEST(LsgFileRefuse, ClosestPointsOfTheWrongCountOrNonFinite) {
   EXPECT_THROW(encode_lsg(sb.band, options), Error);
 }
 
+// ---------------------------------------------------------------------------------------------
+// (e) summarize_lsg (what levelsetd info reads): the decode's checks without keeping values.
+
+testing::AssertionResult summary_matches(const std::string& bytes) {
+  const LsgReadResult r = decode_lsg(bytes, kName);
+  const LsgSummary s = summarize_lsg(bytes, kName);
+  if (s.header.bricks != r.band.brick_count() || s.header.active_voxels != r.band.active_voxel_count() ||
+      s.header.closest_points != r.header.closest_points || s.file_bytes != bytes.size())
+    return testing::AssertionFailure() << "counts differ";
+  if (s.memory_bytes != r.band.memory_bytes())
+    return testing::AssertionFailure() << "memory " << s.memory_bytes << " vs " << r.band.memory_bytes();
+  if (!(s.active_index_bounds == r.band.active_index_bounds())) return testing::AssertionFailure() << "bounds differ";
+  return testing::AssertionSuccess();
+}
+
+// Both refuse with the same code, or both accept.
+testing::AssertionResult same_verdict(const std::string& bytes) {
+  std::optional<ErrorCode> a, b;
+  try { (void)decode_lsg(bytes, kName); } catch (const Error& e) { a = e.code(); }
+  try { (void)summarize_lsg(bytes, kName); } catch (const Error& e) { b = e.code(); }
+  if (a != b)
+    return testing::AssertionFailure() << "decode: " << (a ? to_string(*a) : "accepted")
+                                       << ", summary: " << (b ? to_string(*b) : "accepted");
+  return testing::AssertionSuccess() << (a ? to_string(*a) : "accepted");
+}
+
+TEST(LsgFileSummary, AgreesWithTheDecodedBand) {
+  for (const char* name : {"sphere", "torus", "knot", "box", "dumbbell"})
+    EXPECT_TRUE(summary_matches(encode_lsg(test::make_shape_band(name, 32).band))) << name;
+  EXPECT_TRUE(summary_matches(encode_lsg(negative_coord_band())));
+  EXPECT_TRUE(summary_matches(encode_lsg(small_band())));
+  EXPECT_TRUE(summary_matches(encode_lsg(NarrowBand(odd_frame()))));
+  const auto sb = test::make_shape_band("torus", 24);
+  std::vector<Vec3f> points(sb.band.active_voxel_count(), Vec3f{1.0f, -2.0f, 3.0f});
+  LsgWriteOptions options;
+  options.closest_points = points;
+  EXPECT_TRUE(summary_matches(encode_lsg(sb.band, options)));
+}
+
+TEST(LsgFileSummary, RefusesWhatTheDecodeRefuses) {
+  const RawBand good = raw_band_of(small_band());
+  EXPECT_TRUE(same_verdict(craft(good)));
+  // Every inside bit of every active voxel flipped in turn, and every value negated.
+  for (std::size_t b = 0; b < good.bricks.size(); ++b)
+    good.bricks[b].active.for_each_set([&](int n) {
+      RawBand r = good;
+      r.bricks[b].inside.assign(n, !r.bricks[b].inside.test(n));
+      EXPECT_TRUE(same_verdict(craft(r))) << "brick " << b << " voxel " << n;
+    });
+  for (std::size_t i = 0; i < good.values.size(); ++i) {
+    RawBand r = good;
+    r.values[i] = -r.values[i];
+    EXPECT_TRUE(same_verdict(craft(r))) << "value " << i;
+    for (float bad : {std::numeric_limits<float>::quiet_NaN(), std::numeric_limits<float>::infinity(),
+                      -std::numeric_limits<float>::infinity(), std::bit_cast<float>(0x7f800001u),
+                      std::bit_cast<float>(0xff800001u), -0.0f, 0.0f, std::bit_cast<float>(0x80000001u),
+                      std::numeric_limits<float>::max(), -std::numeric_limits<float>::max()}) {
+      r.values[i] = bad;
+      EXPECT_TRUE(same_verdict(craft(r))) << "value " << i << " = " << bad;
+    }
+  }
+  // -0 is not < 0: accepted with the inside bit clear, refused with it set.
+  RawBand zero = good;
+  int first = -1;
+  zero.bricks[0].active.for_each_set([&](int n) { if (first < 0) first = n; });
+  zero.values[0] = -0.0f;
+  zero.bricks[0].inside.assign(first, false);
+  EXPECT_NO_THROW((void)summarize_lsg(craft(zero), kName));
+  zero.bricks[0].inside.assign(first, true);
+  EXPECT_THROW((void)summarize_lsg(craft(zero), kName), Error);
+  // Masks and counts that disagree, bricks out of order.
+  RawBand more = good;
+  more.bricks[0].active.set(511);
+  EXPECT_TRUE(same_verdict(craft_raw(header_of(good, 0, 0), raw_payload_of(more))));
+  RawBand swapped = good;
+  std::swap(swapped.bricks[0], swapped.bricks[1]);
+  EXPECT_TRUE(same_verdict(craft(swapped)));
+  // A closest point that is not finite (the writer refuses them, so the payload is built here).
+  for (std::size_t at : {std::size_t{0}, good.values.size() + 1, 3 * good.values.size() - 1}) {
+    std::string raw = raw_payload_of(good);
+    std::vector<float> planar(3 * good.values.size(), 0.5f);
+    planar[at] = std::numeric_limits<float>::infinity();
+    for (int plane = 0; plane < 4; ++plane)
+      for (float v : planar) raw.push_back(static_cast<char>((std::bit_cast<std::uint32_t>(v) >> (8 * plane)) & 0xff));
+    Header h = header_of(good, 0, 0);
+    h.flags |= 2;
+    EXPECT_TRUE(same_verdict(craft_raw(h, raw))) << at;
+    EXPECT_THROW((void)summarize_lsg(craft_raw(h, raw), kName), Error) << at;
+  }
+}
+
 }  // namespace
 }  // namespace levelset
