@@ -227,6 +227,7 @@ NarrowBand JobContext::input_band(const config::Set& input) const {
     SdfBuildOptions o;
     o.frame = frame_for(placed);
     o.progress = options_.progress;
+    if (options_.max_domain_voxels > 0) o.max_domain_voxels = options_.max_domain_voxels;
     log("input: built-in " + shape->name());
     return build_from_sdf([&](const Vec3d& p) { return scale * shape->distance((p - translate) / scale); }, placed, o)
         .band;
@@ -238,6 +239,7 @@ NarrowBand JobContext::input_band(const config::Set& input) const {
     CptOptions o;
     o.frame = frame_for(read.mesh.bounds());
     o.progress = options_.progress;
+    if (options_.max_domain_voxels > 0) o.max_domain_voxels = options_.max_domain_voxels;
     log("input: " + path + " (" + std::to_string(read.mesh.triangles.size()) + " triangles), closest point transform");
     return closest_point_transform(read.mesh, o).band;
   }

@@ -49,6 +49,7 @@ struct JobOptions {
   // STEM<suffix>.lsg (also when output { lsg = no } leaves the file out). on_step: called after each step of the evolve job,
   // from the calling thread (previews, checkpoints).
   std::shared_ptr<const NarrowBand> input_band;
+  std::uint64_t max_domain_voxels = 0;  // shapes and meshes: the grid box's voxel budget (0: the builders')
   std::function<void(const NarrowBand& band, std::string_view suffix)> band_sink;
   std::function<void(const evolve::StepInfo& step)> on_step;
 };

@@ -205,7 +205,7 @@ void HttpServer::install() {
           });
           if (over) throw ApiError(413, "payload_too_large", "the body is larger than max_body_bytes (" + std::to_string(limit) + ")");
         }
-        if (!replayed) route.handler(ctx);
+        if (!replayed) run_handler(route, ctx);
       } catch (const ApiError& e) {
         write_error(res, e);
       } catch (const Error& e) {

@@ -14,6 +14,8 @@ json RouteContext::body() const {
   if (body_text.empty()) return json::object();
   try {
     return json::parse(body_text);
+  } catch (const json::out_of_range& e) {  // a number beyond double's range (1e999)
+    throw ApiError(400, "malformed_json", std::string("the body has a number out of range: ") + e.what());
   } catch (const json::parse_error& e) {
     // Line and column of the byte where parsing stopped.
     std::size_t line = 1, column = 1;
@@ -35,6 +37,16 @@ void RouteContext::reply(int status, const json& j, const std::string& location)
   res.status = status;
   if (!location.empty()) res.set_header("Location", location);
   res.set_content(j.dump(-1, ' ', false, json::error_handler_t::replace), "application/json");
+}
+
+void run_handler(const Route& route, RouteContext& ctx) {
+  try {
+    route.handler(ctx);
+  } catch (const json::type_error& e) {
+    throw ApiError(422, "invalid_argument", std::string("a field of the body has the wrong type: ") + e.what());
+  } catch (const json::out_of_range& e) {
+    throw ApiError(422, "invalid_argument", std::string("a field of the body is out of range: ") + e.what());
+  }
 }
 
 const std::vector<Route>& api_routes() {

@@ -40,6 +40,9 @@ struct Route {
 };
 
 const std::vector<Route>& api_routes();
+// Runs the route's handler; a JSON field of the wrong type (a number where a name belongs)
+// becomes ApiError 422 naming it. Anything but ApiError and levelset::Error escaping is a bug.
+void run_handler(const Route& route, RouteContext& ctx);
 void add_system_routes(std::vector<Route>& routes);
 void add_session_routes(std::vector<Route>& routes);
 void add_job_routes(std::vector<Route>& routes);

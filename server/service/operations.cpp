@@ -73,6 +73,7 @@ jobs::JobOptions job_options(const OperationContext& ctx, std::optional<NarrowBa
   o.confine_inputs = true;
   o.progress = ctx.progress;
   o.input_band = ctx.input;
+  o.max_domain_voxels = ctx.max_domain_voxels;
   o.on_step = ctx.on_step;
   if (ctx.log) o.log = [log = ctx.log](std::string_view line) { log(std::string(line)); };
   o.band_sink = [&final_band](const NarrowBand& band, std::string_view suffix) {

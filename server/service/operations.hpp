@@ -38,6 +38,7 @@ struct OperationContext {
   std::function<void(const evolve::StepInfo& step)> on_step;
   ProgressHook progress;
   int max_formula_length = 4096;
+  std::uint64_t max_domain_voxels = 0;  // grid box budget of bands built from shapes and meshes
 };
 
 struct OperationResult {

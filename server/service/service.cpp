@@ -132,6 +132,7 @@ Reply Service::create_session(const json& body) {
     ctx.uploads_dir = uploads_->dir();
     ctx.work_dir = data_;
     ctx.max_formula_length = config_.max_formula_length;
+    ctx.max_domain_voxels = domain_budget();
     OperationResult r = run_operation(ctx);
     auto s = sessions_->create(config_.replica, name, std::move(*r.band), {{"primitive", body["primitive"]}, {"raster", body.value("raster", json::object())}});
     return {201, s->describe(), "/api/v1/sessions/" + s->id()};

@@ -101,6 +101,9 @@ class Service {
   void load_journal();
   std::shared_ptr<Job> make_job(const nlohmann::json& request, const std::string& session_id);
   std::filesystem::path job_dir(const std::string& job_id) const;
+  // Grid boxes of bands built from shapes and meshes: 64x the voxels a session may hold, so a
+  // request for an absurd resolution is refused before any work, not after minutes of it.
+  std::uint64_t domain_budget() const { return config_.max_session_voxels * 64; }
 
   ServiceConfig config_;
   std::filesystem::path data_;

@@ -244,6 +244,7 @@ void Service::run_job(Job& job) {
   ctx.uploads_dir = uploads_->dir();
   ctx.work_dir = work;
   ctx.max_formula_length = config_.max_formula_length;
+  ctx.max_domain_voxels = domain_budget();
   ctx.session_band_path = [this](const std::string& id) {
     auto other = sessions_->get(id);
     const fs::path p = other->dir() / ("operand-" + std::to_string(other->version()) + ".lsg");
@@ -259,8 +260,9 @@ void Service::run_job(Job& job) {
     last_progress = now;
     job.set_progress({{"fraction", fraction}, {"stage", std::string(stage)}});
   };
-  const int total_steps = request.value("steps", 0);
-  const double total_time = request.value("time", 0.0);
+  // For progress only; the operation validates these (a string here is its 422, not ours).
+  const int total_steps = request.contains("steps") && request["steps"].is_number() ? request["steps"].get<int>() : 0;
+  const double total_time = request.contains("time") && request["time"].is_number() ? request["time"].get<double>() : 0.0;
   ctx.on_step = [&](const evolve::StepInfo& info) {
     const auto now = Clock::now();
     const double elapsed = std::chrono::duration<double>(now - started).count();
@@ -351,7 +353,8 @@ void Service::run_job(Job& job) {
                                               {{"op", request.value("op", "")}, {"job", job.id()}, {"params", job.request()}});
         result["session"] = session->id();
       } else {
-        auto created = sessions_->create(config_.replica, job.request().value("name", ""), std::move(*r.band),
+        const json& name = job.request().contains("name") ? job.request()["name"] : json();
+        auto created = sessions_->create(config_.replica, name.is_string() ? name.get<std::string>() : "", std::move(*r.band),
                                          {{"job", job.id()}, {"params", job.request()}});
         result["session"] = created->id();
         result["version"] = 1;

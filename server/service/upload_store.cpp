@@ -148,7 +148,10 @@ json UploadStore::finish(Writer& w) {
   try {
     j = validate(named, w.format_);
   } catch (const Error& e) {
-    throw ApiError::from_error(Error(e.code(), "upload (" + w.format_ + ")", e.reason() + " [at " + e.where().substr(e.where().rfind('/') + 1) + "]"));
+    // The place names the upload id, not the temporary file the readers saw.
+    std::string at = e.where().substr(e.where().rfind('/') + 1);
+    if (at.rfind(named.filename().string(), 0) == 0) at = w.id_ + at.substr(named.filename().string().size());
+    throw ApiError::from_error(Error(e.code(), "upload (" + w.format_ + ")", e.reason() + " [at " + at + "]"));
   }
   j["id"] = w.id_;
   j["format"] = w.format_;
