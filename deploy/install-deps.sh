@@ -20,6 +20,8 @@ PACKAGES=(
   libopenmesh-dev
   # tests and benchmarks (OpenVDB is linked into the benchmark target only)
   libgtest-dev libgmock-dev libbenchmark-dev libopenvdb-dev
+  # daemon benchmark (bench_server): HTTP load generator
+  wrk
   # real sample data: CGAL's meshes, point clouds and 3D images
   libcgal-demo
   # applications: kd-tree for distances to point clouds (header-only)

@@ -138,6 +138,10 @@ void HttpServer::install() {
   svr.set_read_timeout(std::chrono::milliseconds(std::int64_t(c.read_timeout * 1000)));
   svr.set_write_timeout(std::chrono::seconds(30));
   svr.set_keep_alive_timeout(5);
+  svr.set_keep_alive_max_count(1000);  // the library default (5) reconnects every fifth request
+  // Headers and body go out in separate writes: without TCP_NODELAY, Nagle's algorithm holds
+  // the body until the client's delayed ACK (40 ms a request on a kept-alive connection).
+  svr.set_tcp_nodelay(true);
   svr.set_socket_options([this](socket_t fd) {
     int yes = 1;
     ::setsockopt(fd, SOL_SOCKET, SO_REUSEADDR, &yes, sizeof yes);

@@ -1,6 +1,11 @@
 #include "service/job_scheduler.hpp"
 
+#include <sys/resource.h>
+#include <sys/syscall.h>
+#include <unistd.h>
+
 #include <tbb/task_arena.h>
+#include <tbb/task_scheduler_observer.h>
 
 #include "core/error.hpp"
 #include "core/file_io.hpp"
@@ -109,6 +114,26 @@ void Job::log(const std::string& line) { events_.publish("log", {{"line", line}}
 
 // ---- JobScheduler ---------------------------------------------------------------------------
 
+namespace {
+
+// Threads computing a job run at a lower priority (nice 5) while they are in its arena, so the
+// HTTP threads (nice 0) answer at once even when a job keeps every core busy.
+class BackgroundPriority : public tbb::task_scheduler_observer {
+ public:
+  explicit BackgroundPriority(tbb::task_arena& arena) : tbb::task_scheduler_observer(arena) { observe(true); }
+  ~BackgroundPriority() override { observe(false); }
+  void on_scheduler_entry(bool) override { set_nice(5); }
+  void on_scheduler_exit(bool) override { set_nice(0); }
+
+ private:
+  static void set_nice(int value) {
+    // Per thread on Linux: setpriority on the thread id.
+    ::setpriority(PRIO_PROCESS, static_cast<id_t>(::syscall(SYS_gettid)), value);
+  }
+};
+
+}  // namespace
+
 JobScheduler::JobScheduler(int workers, int max_queued, int threads_per_job, Runner runner)
     : max_queued_(max_queued), threads_per_job_(std::max(1, threads_per_job)), runner_(std::move(runner)) {
   for (int i = 0; i < std::max(1, workers); ++i) workers_.emplace_back([this] { work(); });
@@ -175,6 +200,8 @@ void JobScheduler::work() {
       ++running_;
     }
     tbb::task_arena arena(threads_per_job_);
+    arena.initialize();
+    BackgroundPriority priority(arena);
     arena.execute([&] { runner_(*job); });
     {
       std::lock_guard lock(mutex_);
