@@ -26,6 +26,12 @@ Service::Service(ServiceConfig config) : config_(std::move(config)), data_(confi
       data_ / "sessions",
       SessionLimits{config_.max_sessions, config_.max_session_voxels, config_.max_band_memory});
   uploads_ = std::make_unique<UploadStore>(data_ / "uploads", config_.max_upload_bytes, config_.max_uploads_total);
+  // Atomic writes cut off by kill -9 leave "<name>.tmp-<pid>-<n>" beside the final name, which
+  // is intact: remove them everywhere before loading.
+  for (auto it = fs::recursive_directory_iterator(data_, ec); !ec && it != fs::recursive_directory_iterator();
+       it.increment(ec))
+    if (it->path().filename().string().find(".tmp-") != std::string::npos) fs::remove(it->path(), ec);
+  ec.clear();
   startup_problems_ = sessions_->load_all();
   const unsigned cores = std::max(1u, std::thread::hardware_concurrency());
   scheduler_ = std::make_unique<JobScheduler>(config_.max_jobs, config_.max_queued_jobs,
