@@ -431,6 +431,54 @@ def test_security_defaults():
         d.stop()
 
 
+def test_tls_cors_logs():
+    """HTTPS with --tls-cert/--tls-key, CORS for the configured origin only, JSON log lines."""
+    work = fresh("tls")
+    os.makedirs(work)
+    cert, key = os.path.join(work, "cert.pem"), os.path.join(work, "key.pem")
+    subprocess.run(["openssl", "req", "-x509", "-newkey", "rsa:2048", "-nodes", "-keyout", key, "-out", cert,
+                    "-days", "1", "-subj", "/CN=127.0.0.1"], check=True, capture_output=True)
+    d = Daemon(BIN, os.path.join(work, "data"), "--tls-cert", cert, "--tls-key", key, "--cors-origin",
+               "https://viewer.example", "--log-format", "json")
+    try:
+        check(d.url.startswith("https://"), f"the ready line names https: {d.url}")
+        status, hdrs, body = d.get("/api/v1", headers={"Origin": "https://viewer.example"})
+        check(status == 200 and hdrs.get("Access-Control-Allow-Origin") == "https://viewer.example", f"CORS: {hdrs}")
+        status, hdrs, body = d.get("/api/v1", headers={"Origin": "https://elsewhere.example"})
+        check("Access-Control-Allow-Origin" not in hdrs, "CORS for another origin")
+        status, hdrs, _ = d.request("OPTIONS", "/api/v1/sessions", headers={"Origin": "https://viewer.example"})
+        check(status == 204 and "POST" in hdrs.get("Access-Control-Allow-Methods", ""), f"preflight: {status} {hdrs}")
+        status, hdrs, _ = d.request("GET", "/healthz", headers={"X-Request-Id": "tls-check-1"})
+    finally:
+        d.stop()
+    lines = [json.loads(line) for line in d.read_log().splitlines() if line.startswith("{")]
+    check(any(entry.get("request_id") == "tls-check-1" and entry.get("status") == 200 for entry in lines),
+          "the JSON log line carries the request id")
+    plain = subprocess.run(["curl", "-s", "-o", "/dev/null", "-w", "%{http_code}", d.url.replace("https", "http") + "/healthz"],
+                           capture_output=True, text=True)
+    check(plain.stdout != "200", "plain HTTP to the TLS port is not served")
+
+
+def test_preview_while_running():
+    """While an evolution runs, mesh reads see its latest step; the committed version stays."""
+    d = Daemon(BIN, fresh("preview"))
+    try:
+        s = sphere_session(d, 48)
+        job = long_evolve(d, s["id"], steps=100000, speed="-(k1+k2)*0.01")
+        wait_running(d, job["id"], 5)
+        _, h1, m1 = d.request("GET", f"/api/v1/sessions/{s['id']}/mesh?format=off")
+        wait_running(d, job["id"], d.get(f"/api/v1/jobs/{job['id']}")[2]["progress"]["step"] + 30)
+        _, h2, m2 = d.request("GET", f"/api/v1/sessions/{s['id']}/mesh?format=off")
+        check(h1["ETag"] != h2["ETag"] and m1 != m2, "the preview moves with the job")
+        check(d.get(f"/api/v1/sessions/{s['id']}")[2]["version"] == 1, "the committed version stays while it runs")
+        d.json_request("DELETE", f"/api/v1/jobs/{job['id']}")
+        d.wait_job(job["id"])
+        _, h3, m3 = d.request("GET", f"/api/v1/sessions/{s['id']}/mesh?format=off")
+        check(h3["ETag"] not in (h1["ETag"], h2["ETag"]), "after the cancel the mesh is the committed one again")
+    finally:
+        d.stop()
+
+
 def test_concurrency():
     """64 clients creating sessions, submitting jobs, polling and holding event streams."""
     d = Daemon(BIN, fresh("concurrency"), "--max-queued-jobs", "256")

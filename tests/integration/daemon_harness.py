@@ -9,6 +9,7 @@ import json
 import os
 import re
 import signal
+import ssl
 import subprocess
 import time
 import urllib.error
@@ -69,6 +70,10 @@ class Daemon:
         self.log.close()
 
     # ---- HTTP
+    def _ssl(self):
+        """HTTPS to a test daemon: its self-signed certificate is not verified."""
+        return ssl._create_unverified_context() if self.url.startswith("https") else None
+
     def request(self, method, path, body=None, headers=None, timeout=60):
         data = body
         hdrs = dict(headers or {})
@@ -79,7 +84,7 @@ class Daemon:
             data = body.encode()
         req = urllib.request.Request(self.url + path, data=data, method=method, headers=hdrs)
         try:
-            with urllib.request.urlopen(req, timeout=timeout) as r:
+            with urllib.request.urlopen(req, timeout=timeout, context=self._ssl()) as r:
                 return r.status, dict(r.headers), r.read()
         except urllib.error.HTTPError as e:
             return e.code, dict(e.headers), e.read()
@@ -102,7 +107,7 @@ class Daemon:
         """Reads SSE events [(id, type, data)] until until(event) is true or the stream ends."""
         req = urllib.request.Request(self.url + path, headers=dict(headers or {}))
         out = []
-        with urllib.request.urlopen(req, timeout=timeout) as r:
+        with urllib.request.urlopen(req, timeout=timeout, context=self._ssl()) as r:
             event = {}
             for raw in r:
                 line = raw.decode("utf-8").rstrip("\n")
