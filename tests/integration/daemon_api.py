@@ -385,6 +385,9 @@ def test_refusals():
         c = d.post("/api/v1/sessions", {"primitive": "sphere", "raster": {"resolution": 16}}, headers=rw)[2]["id"]
         long_job = d.post(f"/api/v1/sessions/{a}/jobs", {"op": "evolve", "speed": "0.01", "steps": 10 ** 7,
                                                         "report_every": 0}, headers=rw)[2]
+        # Running (out of the queue) before the queue is filled: one waiting job fills it.
+        d.events(f"/api/v1/jobs/{long_job['id']}/events", headers=ro,
+                 until=lambda e: e[1] == "progress" and e[2].get("step", 0) >= 1)
         status, _, body = d.post(f"/api/v1/sessions/{a}/jobs", {"op": "measure"}, headers=rw)
         check(status == 409, f"busy session: {status} {body}")
         status, _, queued = d.post(f"/api/v1/sessions/{b}/jobs", {"op": "measure"}, headers=rw)
