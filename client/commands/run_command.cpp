@@ -44,7 +44,7 @@ config::Set parse_job(const RunArgs& a, std::string& text) {
     return root;
   } catch (const Error& e) {
     const ClientError::Kind kind = e.code() == ErrorCode::IoError ? ClientError::Kind::Local : ClientError::Kind::Usage;
-    throw ClientError(kind, e.code() == ErrorCode::IoError ? "io_error" : "invalid_job", e.what());
+    throw ClientError(kind, e.code() == ErrorCode::IoError ? "io_error" : "invalid_job", e.where() + ": " + e.reason());
   }
 }
 

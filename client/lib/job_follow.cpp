@@ -17,7 +17,7 @@ bool job_ended(const std::string& state) {
 
 json follow_job(const Api& api, const std::string& job_id, const FollowCallbacks& cb) {
   const std::string path = "/api/v1/jobs/" + Api::encode(job_id);
-  std::string last_id;
+  std::string last_id = "0";  // from the job's first event: its whole log (the server's ring holds 1024)
   bool done = false;
   double failing_since = -1;  // seconds of consecutive connection failures
   auto started_failing = Clock::now();
@@ -51,7 +51,7 @@ json follow_job(const Api& api, const std::string& job_id, const FollowCallbacks
       const double waited = std::chrono::duration<double>(Clock::now() - started_failing).count();
       if (waited >= cb.reconnect_seconds) throw;
       if (cb.on_notice) cb.on_notice("connection lost (" + e.message() + "); resuming after event " +
-                                     (last_id.empty() ? std::string("0") : last_id));
+                                     last_id);
       std::this_thread::sleep_for(std::chrono::milliseconds(std::min(2000, 100 << std::min(attempt, 4))));
       continue;
     }

@@ -1,5 +1,6 @@
 // follow_job: follows GET /api/v1/jobs/{jid}/events (Server-Sent Events) to the job's end and
-// returns its final description (GET /api/v1/jobs/{jid}). A dropped connection is resumed with
+// returns its final description (GET /api/v1/jobs/{jid}). It asks for the events after id 0, so
+// the whole log comes, also what the job said before the stream opened. A dropped connection is resumed with
 // Last-Event-ID (the server replays what came after it); connection failures are retried for
 // `reconnect_seconds` in all before ClientError{Connect}. A job that already ended answers at
 // once. The caller decides what a final state means (succeeded or not).
