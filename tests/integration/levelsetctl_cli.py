@@ -49,8 +49,12 @@ SIZES = {
 TIMED_FILES = (".log", ".stats.json")
 
 
+class Failure(Exception):
+    pass
+
+
 def fail(msg):
-    sys.exit("levelsetctl_cli: FAIL: " + msg)
+    raise Failure(msg)
 
 
 def check(cond, msg):
@@ -59,9 +63,10 @@ def check(cond, msg):
 
 
 class Daemon:
-    def __init__(self, binary, data_dir, env):
-        self.proc = subprocess.Popen([binary, "serve", "--port", "0", "--data", data_dir], stdout=subprocess.PIPE,
-                                     stderr=open(data_dir + ".stderr", "w"), text=True, env=env)
+    def __init__(self, binary, data_dir, env, flags=()):
+        self.stderr = data_dir + ".stderr"
+        self.proc = subprocess.Popen([binary, "serve", "--port", "0", "--data", data_dir, *flags],
+                                     stdout=subprocess.PIPE, stderr=open(self.stderr, "w"), text=True, env=env)
         deadline = time.time() + 30
         line = ""
         while time.time() < deadline:
@@ -356,6 +361,19 @@ def scenario_commands(ctx, cgal):
     check(proxy.cuts == 1 and "connection lost" in p.stderr, f"the stream was not cut: {p.stderr}")
     check(step_lines(p.stderr) == list(range(25, 201, 25)), f"log lines after the resume: {p.stderr}")
 
+    # Tokens: --token and $LEVELSET_TOKEN are sent as a bearer token; none is refused.
+    token = "levelsetctl-test-token-0123456789"
+    secured = Daemon(ctx.levelsetd, os.path.join(ctx.scratch, "data_tokens"), ctx.env, ["--tokens", token])
+    try:
+        ctx.refused(["sessions", "list"], 1, "unauthorized", server=secured.url)
+        ctx.ok(["--token", token, "sessions", "list"], server=secured.url)
+        p = subprocess.run([ctx.ctl, "sessions", "create", "--primitive", "box", "--resolution", "16"],
+                           capture_output=True, text=True, env=dict(ctx.env, LEVELSET_SERVER=secured.url,
+                                                                    LEVELSET_TOKEN=token))
+        check(p.returncode == 0 and "-s-" in p.stdout, f"$LEVELSET_SERVER / $LEVELSET_TOKEN: {p.stderr}")
+    finally:
+        secured.stop()
+
     # Uploads: a good one, and malformed ones refused with the server's own message.
     mesh = os.path.join(cgal, "meshes", "elephant.off")
     uid = ctx.ok(["upload", mesh]).stdout.strip()
@@ -398,9 +416,10 @@ def main():
     env = dict(os.environ, LEVELSET_CGAL_DATA=cgal)
     env.pop("LEVELSET_SERVER", None)
     env.pop("LEVELSET_TOKEN", None)
-    daemon = Daemon(levelsetd, os.path.join(scratch, "data"), env)
     t0 = time.time()
+    daemon = None
     try:
+        daemon = Daemon(levelsetd, os.path.join(scratch, "data"), env)
         ctx = Ctx(levelsetd, ctl, scratch, env, daemon.url)
         if scenario == "jobs":
             scenario_jobs(ctx, cgal, jobs_dir)
@@ -408,8 +427,14 @@ def main():
             scenario_commands(ctx, cgal)
         else:
             fail(f"unknown scenario {scenario}")
+    except Failure as e:
+        if daemon is not None and os.path.exists(daemon.stderr):
+            tail = open(daemon.stderr, errors="replace").read()[-3000:]
+            print(f"--- the daemon's stderr (last 3000 characters):\n{tail}", file=sys.stderr)
+        sys.exit(f"levelsetctl_cli: {scenario}: FAIL after {time.time() - t0:.1f} s: {e}")
     finally:
-        daemon.stop()
+        if daemon is not None:
+            daemon.stop()
     print(f"levelsetctl_cli: {scenario}: passed in {time.time() - t0:.1f} s")
 
 
