@@ -33,8 +33,22 @@ void upload(RouteContext& c) {
   const std::string format = query_text(c.req, "format", "");
   if (!c.req.has_header("Content-Length"))
     throw ApiError(411, "length_required", "send the file with a Content-Length");
+  // A declared length over the limit is refused before reading (httplib's payload limit would
+  // otherwise end the read at once and the empty file be validated as "empty").
+  const std::uint64_t limit = c.service.config().max_upload_bytes;
+  const std::string length = c.req.get_header_value("Content-Length");
+  if (length.size() > 19 || std::strtoull(length.c_str(), nullptr, 10) > limit)
+    throw ApiError(413, "payload_too_large", "the upload has " + length.substr(0, 20) + " bytes, more than " +
+                                                 std::to_string(limit) + " (max_upload_bytes)");
   auto writer = c.service.uploads().begin(c.service.config().replica, format);
-  (*c.reader)([&](const char* data, std::size_t n) { return writer->write(data, n); });
+  bool refused = false;  // by the writer: over the limit or a failed write (finish says which)
+  const bool complete = (*c.reader)([&](const char* data, std::size_t n) {
+    if (writer->write(data, n)) return true;
+    refused = true;
+    return false;
+  });
+  if (!complete && !refused)
+    throw ApiError(400, "incomplete_body", "the upload ended before its Content-Length");
   const json stored = c.service.uploads().finish(*writer);
   c.reply(201, stored, "/api/v1/uploads/" + stored["id"].get<std::string>());
 }
