@@ -4,6 +4,7 @@
 // job failed; 2 usage (also a malformed job file for `run`); 3 cannot connect (or the
 // connection broke for good); 4 a local file could not be read or written. Errors print one
 // line on stderr: "levelsetctl: CODE: MESSAGE".
+#include <csignal>
 #include <cstdio>
 #include <cstdlib>
 #include <exception>
@@ -37,6 +38,9 @@ int fail(const std::string& code, const std::string& message, int exit_code) {
 
 int main(int argc, char** argv) {
   using namespace levelset::client;
+  // A server that answers and closes while a body is still being sent must give an error, not
+  // kill the client with SIGPIPE.
+  std::signal(SIGPIPE, SIG_IGN);
   CLI::App app("levelsetctl: command-line client of levelsetd serve", "levelsetctl");
   app.set_version_flag("--version", "levelsetctl " LEVELSET_VERSION);
   app.require_subcommand(1);

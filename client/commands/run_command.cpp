@@ -78,7 +78,7 @@ void run(const RunArgs& a, const Globals& g) {
     if (f.path.empty()) continue;
     auto it = uploaded.find(f.path);
     if (it == uploaded.end()) {
-      const json u = api.upload("/api/v1/uploads?format=" + Api::encode(upload_format_of(f.path)), f.path);
+      const json u = api.upload(f.path, upload_format_of(f.path));
       it = uploaded.emplace(f.path, u.value("id", "")).first;
       if (!a.quiet) std::fprintf(stderr, "uploaded %s as %s\n", f.path.c_str(), it->second.c_str());
     }

@@ -41,7 +41,7 @@ void add_upload_command(CLI::App& app, Globals& g) {
   sub->add_flag("--json", a->json, "Print the server's description of the upload instead of its id");
   sub->callback([a, &g] {
     const std::string format = a->format.empty() ? upload_format_of(a->file) : a->format;
-    const nlohmann::json r = g.api().upload("/api/v1/uploads?format=" + Api::encode(format), a->file);
+    const nlohmann::json r = g.api().upload(a->file, format);
     if (a->json) {
       print_json(r);
     } else {

@@ -2,6 +2,7 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <memory>
@@ -107,12 +108,27 @@ json Api::del(const std::string& path) const {
   return answer(server_, c->Delete(prefix_ + path));
 }
 
-json Api::upload(const std::string& path, const std::string& file) const {
+json Api::upload(const std::string& file, const std::string& format) const {
   std::error_code ec;
   if (!fs::is_regular_file(file, ec)) throw ClientError(Kind::Local, "io_error", "no such file: " + file);
   const std::uint64_t size = fs::file_size(file, ec);
   auto in = std::make_shared<std::ifstream>(file, std::ios::binary);
   if (ec || !*in) throw ClientError(Kind::Local, "io_error", "cannot read " + file);
+  if (size > (1u << 20)) {
+    const json info = get("/api/v1");
+    const json formats = info.value("upload_formats", json::array());
+    if (formats.is_array() && !formats.empty() && std::find(formats.begin(), formats.end(), format) == formats.end())
+      throw ClientError(Kind::Server, "unsupported_format",
+                        "unknown upload format '" + format + "' (known: " + formats.dump() + ")", 415);
+    const json limits = info.value("limits", json::object());
+    if (limits.contains("max_upload_bytes") && limits["max_upload_bytes"].is_number() &&
+        size > limits["max_upload_bytes"].get<std::uint64_t>())
+      throw ClientError(Kind::Server, "payload_too_large",
+                        file + " has " + std::to_string(size) + " bytes, more than the server's max_upload_bytes (" +
+                            std::to_string(limits["max_upload_bytes"].get<std::uint64_t>()) + ")",
+                        413);
+  }
+  const std::string path = "/api/v1/uploads?format=" + encode(format);
   bool read_failed = false;
   auto c = make_client(origin_, token_, 600);  // the server validates the whole file before it answers
   auto r = c->Post(

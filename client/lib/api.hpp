@@ -28,8 +28,11 @@ class Api {
   nlohmann::json patch(const std::string& path, const nlohmann::json& body) const;
   nlohmann::json del(const std::string& path) const;  // null for 204
 
-  // Streams a local file as the raw body (with its Content-Length); the server's JSON answer.
-  nlohmann::json upload(const std::string& path, const std::string& file) const;
+  // POST /api/v1/uploads?format=FORMAT with the file streamed as the raw body (with its
+  // Content-Length); the server's JSON answer. A file over 1 MiB is first checked against the
+  // server's formats and max_upload_bytes (GET /api/v1): a server refusing before it reads the
+  // body closes the connection while the client still sends, and its answer would be lost.
+  nlohmann::json upload(const std::string& file, const std::string& format) const;
   // GET into `file`, written to FILE.part-PID and renamed at the end (nothing left on errors).
   std::uint64_t download(const std::string& path, const std::string& file) const;
 

@@ -363,7 +363,8 @@ def scenario_commands(ctx, cgal):
 
     # Tokens: --token and $LEVELSET_TOKEN are sent as a bearer token; none is refused.
     token = "levelsetctl-test-token-0123456789"
-    secured = Daemon(ctx.levelsetd, os.path.join(ctx.scratch, "data_tokens"), ctx.env, ["--tokens", token])
+    secured = Daemon(ctx.levelsetd, os.path.join(ctx.scratch, "data_tokens"), ctx.env,
+                     ["--tokens", token, "--max-upload-bytes", "1000000"])
     try:
         ctx.refused(["sessions", "list"], 1, "unauthorized", server=secured.url)
         ctx.ok(["--token", token, "sessions", "list"], server=secured.url)
@@ -371,6 +372,24 @@ def scenario_commands(ctx, cgal):
                            capture_output=True, text=True, env=dict(ctx.env, LEVELSET_SERVER=secured.url,
                                                                     LEVELSET_TOKEN=token))
         check(p.returncode == 0 and "-s-" in p.stdout, f"$LEVELSET_SERVER / $LEVELSET_TOKEN: {p.stderr}")
+        # An upload over max_upload_bytes: 413 from the server before it reads the body (it
+        # validated an empty file as "the file is empty" before), and from levelsetctl.
+        big = os.path.join(ctx.scratch, "big.off")
+        open(big, "wb").write(b"OFF\n" + b" " * 3_000_000)
+        # (headers only: the answer must come before any of the body is sent)
+        sock = socket.create_connection(("127.0.0.1", int(secured.url.rsplit(":", 1)[1])), timeout=30)
+        sock.sendall(f"POST /api/v1/uploads?format=off HTTP/1.1\r\nHost: x\r\nAuthorization: Bearer {token}\r\n"
+                     f"Content-Length: {os.path.getsize(big)}\r\n\r\n".encode())
+        answer = b""
+        while b"\r\n\r\n" not in answer or not answer.rstrip().endswith(b"}"):
+            d = sock.recv(65536)
+            if not d:
+                break
+            answer += d
+        sock.close()
+        check(answer.startswith(b"HTTP/1.1 413") and b'"payload_too_large"' in answer, f"early refusal: {answer!r}")
+        ctx.refused(["--token", token, "upload", big], 1, "payload_too_large", server=secured.url)
+        ctx.refused(["--token", token, "upload", big, "--format", "nope"], 1, "unsupported_format", server=secured.url)
     finally:
         secured.stop()
 
