@@ -42,6 +42,17 @@ void check_formula(const json& body) {
   }
 }
 
+// Queues the job (429 when full): 202 with its Location; a refused job gives its session back.
+Reply enqueue(JobScheduler& scheduler, const std::shared_ptr<Job>& job, Session* session) {
+  try {
+    scheduler.submit(job);
+  } catch (...) {
+    if (session != nullptr) session->release(job->id());
+    throw;
+  }
+  return {202, job->describe(), "/api/v1/jobs/" + job->id()};
+}
+
 }  // namespace
 
 Reply Service::submit(const std::string& session_id, const json& body) {
@@ -69,13 +80,7 @@ Reply Service::submit(const std::string& session_id, const json& body) {
                                               " (send \"queue\": true to wait for it)");
     }
   }
-  try {
-    scheduler_->submit(job);
-  } catch (...) {
-    if (session) session->release(job->id());
-    throw;
-  }
-  return {202, job->describe(), "/api/v1/jobs/" + job->id()};
+  return enqueue(*scheduler_, job, session.get());
 }
 
 Reply Service::submit_job_file(const json& body) {
@@ -137,13 +142,7 @@ Reply Service::resume(const std::string& job_id) {
     if (!session->claim(job->id())) throw ApiError(409, "session_busy", "another job runs on the session");
     job->holds_session = true;
   }
-  try {
-    scheduler_->submit(job);
-  } catch (...) {
-    if (session) session->release(job->id());
-    throw;
-  }
-  return {202, job->describe(), "/api/v1/jobs/" + job->id()};
+  return enqueue(*scheduler_, job, session.get());
 }
 
 Blob Service::job_file(const std::string& job_id, const std::string& name) {
