@@ -3,7 +3,8 @@
 // uploaded and replaced by their ids (lib/job_inputs.hpp), the job text goes to POST /api/v1/jobs
 // with its file name, its log lines are printed as they come (as `levelsetd run` prints them),
 // and every file of result.files is downloaded into OUTDIR under the same name `levelsetd run`
-// gives it. STEM.stats.json's "outputs" are rewritten to the local paths.
+// gives it. STEM.stats.json's "outputs" are rewritten to the local paths. SIGINT / SIGTERM /
+// SIGHUP while the job runs cancel it on the server (exit 128 + the signal).
 #include <unistd.h>
 
 #include <cstdio>
@@ -15,6 +16,7 @@
 #include "config/config_file.hpp"
 #include "core/error.hpp"
 #include "core/file_io.hpp"
+#include "lib/cancel_on_signal.hpp"
 #include "lib/client_error.hpp"
 #include "lib/job_follow.hpp"
 #include "lib/job_inputs.hpp"
@@ -86,8 +88,10 @@ void run(const RunArgs& a, const Globals& g) {
   }
 
   const std::string name = fs::path(a.job).filename().string();
+  CancelOnSignal cancel_on_signal(api);  // from the submission on, a signal cancels the job
   const json submitted = api.post("/api/v1/jobs", {{"config", text}, {"set", sets}, {"name", name}});
   const std::string job_id = submitted.value("id", "");
+  cancel_on_signal.arm(job_id);
 
   ProgressView view(::isatty(::fileno(stderr)) && !a.quiet ? ProgressView::Mode::Bar : ProgressView::Mode::Off);
   FollowCallbacks cb;
@@ -95,6 +99,7 @@ void run(const RunArgs& a, const Globals& g) {
   if (!a.quiet) cb.on_log = [&view](const std::string& line) { view.message(line, stdout); };
   cb.on_notice = [&view](const std::string& m) { view.message("levelsetctl: " + m, stderr); };
   const json job = follow_job(api, job_id, cb);
+  cancel_on_signal.arm("");  // ended: a signal from here on only ends the client
   view.finish();
   throw_unless_succeeded(job);
 

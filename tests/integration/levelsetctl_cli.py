@@ -10,7 +10,8 @@ Scenarios:
             file naming local input files (relative and absolute) has them uploaded.
   commands  exit codes (a failing job 1, an unknown session 1, a malformed job file 2, usage 2,
             no server 3); `jobs wait` shows progress (lines, and a bar on a terminal) and
-            returns 0 on success, non-zero for a cancelled job; a wait through a proxy that cuts
+            returns 0 on success, non-zero for a cancelled job; SIGTERM to `run` cancels its job;
+            a wait through a proxy that cuts
             the event stream resumes with Last-Event-ID (no log line lost or repeated); uploads
             of malformed files are refused with the server's message; downloads equal the API's.
 Missing binaries, data or job sizes fail the test; nothing is skipped.
@@ -352,6 +353,31 @@ def scenario_commands(ctx, cgal):
     ctx.ok(["jobs", "stop", jid])
     p = ctx.ok(["jobs", "wait", jid])
     check(json.loads(p.stdout)["stopped"] is True, p.stdout)
+
+    # SIGTERM to `run` cancels its job on the server (a workflow system killing the client).
+    long_job = os.path.join(ctx.scratch, "long.conf")
+    open(long_job, "w").write("job = fair\ninput { shape = dumbbell }\nraster { resolution = 64 }\n"
+                              "fair { flow = volume-preserving  steps = 1000000 }\n")
+    before = {j["id"] for j in ctx.http("GET", "/api/v1/jobs")[1]["jobs"]}
+    proc = subprocess.Popen([ctx.ctl, "--server", ctx.url, "run", long_job, "-o", "long_out"], cwd=ctx.scratch,
+                            env=ctx.env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    deadline = time.time() + 30
+    running = []
+    while not running and time.time() < deadline:
+        time.sleep(0.1)
+        running = [j["id"] for j in ctx.http("GET", "/api/v1/jobs")[1]["jobs"]
+                   if j["id"] not in before and j["state"] == "running"]
+    check(running, "the long job never ran")
+    proc.terminate()
+    out, err = proc.communicate(timeout=30)
+    check(proc.returncode == 128 + 15, f"run after SIGTERM: exit {proc.returncode}: {err}")
+    check(f"levelsetctl: cancelled: job {running[0]} cancelled" in err, err)
+    for _ in range(100):
+        state = ctx.http("GET", f"/api/v1/jobs/{running[0]}")[1]["state"]
+        if state != "running":
+            break
+        time.sleep(0.1)
+    check(state == "cancelled", f"the job is {state} after its client was killed")
 
     # A dropped event stream resumes with Last-Event-ID: every log line once, in order.
     target = int(ctx.url.rsplit(":", 1)[1])
