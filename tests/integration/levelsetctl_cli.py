@@ -6,7 +6,8 @@ Usage: levelsetctl_cli.py LEVELSETD LEVELSETCTL SCRATCH CGAL_DATA JOBS_DIR SCENA
 Scenarios:
   jobs      `levelsetctl run` of every shipped job file (JOBS_DIR/*.conf, at the reduced sizes
             below) writes the same files as `levelsetd run` with the same --set: mesh, .lsg and
-            every other output byte for byte (the .log and .stats.json carry timings); a job
+            every other output byte for byte (the .log and .stats.json carry timings; the daemon's
+            jobs run on half the threads levelsetd run uses); a job
             file naming local input files (relative and absolute) has them uploaded.
   commands  exit codes (a failing job 1, an unknown session 1, a malformed job file 2, usage 2,
             no server 3); `jobs wait` shows progress (lines, and a bar on a terminal) and
@@ -464,7 +465,9 @@ def main():
     t0 = time.time()
     daemon = None
     try:
-        daemon = Daemon(levelsetd, os.path.join(scratch, "data"), env)
+        # Two jobs at once: each runs in a TBB arena of half the cores (one thread on two cores),
+        # so "jobs" also shows the outputs do not depend on the thread count.
+        daemon = Daemon(levelsetd, os.path.join(scratch, "data"), env, ["--max-jobs", "2"])
         ctx = Ctx(levelsetd, ctl, scratch, env, daemon.url)
         if scenario == "jobs":
             scenario_jobs(ctx, cgal, jobs_dir)
