@@ -22,6 +22,8 @@ PACKAGES=(
   libgtest-dev libgmock-dev libbenchmark-dev libopenvdb-dev
   # daemon benchmark (bench_server): HTTP load generator
   wrk
+  # browser viewer tests: headless Chromium driven by Selenium (run by /usr/bin/python3)
+  chromium chromium-driver python3-selenium
   # real sample data: CGAL's meshes, point clouds and 3D images
   libcgal-demo
   # applications: kd-tree for distances to point clouds (header-only)

@@ -163,12 +163,17 @@ void HttpServer::install() {
       bool replayed = false;
       try {
         // Authentication: tokens when configured (always beyond loopback); probes stay open.
-        const bool probe = route.path == "/healthz" || route.path == "/readyz";
+        // Probes, and the viewer page (static; the token is typed into it), need no token.
+        const bool probe = route.path == "/healthz" || route.path == "/readyz" || route.path == "/";
         if (!tokens_.empty() && !probe) {
           const std::string auth = req.get_header_value("Authorization");
           const Role* role = nullptr;
-          if (auth.rfind("Bearer ", 0) == 0) {
-            const std::string given = auth.substr(7);
+          // Browsers cannot set headers on <img> and EventSource: GET routes also take
+          // ?access_token=.
+          std::string given;
+          if (auth.rfind("Bearer ", 0) == 0) given = auth.substr(7);
+          else if (route.method == "GET" && req.has_param("access_token")) given = req.get_param_value("access_token");
+          if (!given.empty()) {
             for (const auto& [token, r] : tokens_)
               if (same_token(given, token)) role = &r;
           }
@@ -240,11 +245,12 @@ void HttpServer::install() {
     else if (route.method == "DELETE") svr.Delete(pattern, plain);
     else if (route.method == "POST") svr.Post(pattern, with_body);
     else if (route.method == "PATCH") svr.Patch(pattern, with_body);
+    else if (route.method == "PUT") svr.Put(pattern, with_body);
   }
   if (!c.cors_origin.empty())
     svr.Options(".*", [origin = c.cors_origin](const httplib::Request&, httplib::Response& res) {
       res.set_header("Access-Control-Allow-Origin", origin);
-      res.set_header("Access-Control-Allow-Methods", "GET, POST, PATCH, DELETE, OPTIONS");
+      res.set_header("Access-Control-Allow-Methods", "GET, POST, PUT, PATCH, DELETE, OPTIONS");
       res.set_header("Access-Control-Allow-Headers", "Authorization, Content-Type, Idempotency-Key, Last-Event-ID");
       res.status = 204;
     });

@@ -107,6 +107,31 @@ void add_session_routes(std::vector<Route>& r) {
                  auto s = c.service.sessions().get(c.param(1));
                  stream_events(c, s, s->events(), [s] { return s->describe(); });
                }});
+  // ---- the view and frames
+  r.push_back({"GET", "/api/v1/sessions/{id}/view", "The camera and display settings of the session's frames", false,
+               false, {}, nullptr, {{"200", "view settings"}},
+               [](RouteContext& c) { c.reply(200, c.service.sessions().get(c.param(1))->view()); }});
+  r.push_back({"PUT", "/api/v1/sessions/{id}/view",
+               "Move the camera and change display settings of the session's frames and streams (merged)", true, false,
+               {}, kJson, {{"200", "the view settings"}, {"422", "a setting out of range"}}, [](RouteContext& c) {
+                 const json body = c.body();
+                 if (!body.is_object()) throw service::unprocessable("body", "expected an object of view settings");
+                 auto s = c.service.sessions().get(c.param(1));
+                 c.reply(200, c.service.sessions().update_view(*s, body));
+               }});
+  for (const char* what : {"frame", "stream"}) {
+    const bool stream = std::string(what) == "stream";
+    r.push_back({"GET", std::string("/api/v1/sessions/{id}/") + what,
+                 stream ? "The session rendered live as MJPEG (multipart/x-mixed-replace)"
+                        : "The session rendered offscreen as PNG or JPEG",
+                 false, false, {"width", "height", "format", "quality", "shading"}, nullptr,
+                 {{"200", stream ? "multipart/x-mixed-replace stream" : "the image"}, {"422", "a size or setting out of range"},
+                  {"503", "rendering is off or unavailable"}},
+                 [](RouteContext& c) {
+                   c.service.sessions().get(c.param(1));
+                   if (!c.service.rendering()) throw ApiError(503, "rendering_off", c.service.render_status());
+                 }});
+  }
   // ---- results
   r.push_back({"GET", "/api/v1/sessions/{id}/mesh", "The surface as a mesh (chunked; ETag from version and query)",
                false, false, {"iso", "method", "format"}, nullptr,

@@ -7,7 +7,12 @@ namespace levelset::api {
 
 using nlohmann::json;
 
+extern const std::string_view kViewerPage;
+
 void add_system_routes(std::vector<Route>& r) {
+  r.push_back({"GET", "/", "The browser viewer (one static page over this API)", false, false, {}, nullptr,
+               {{"200", "text/html"}},
+               [](RouteContext& c) { c.res.set_content(std::string(kViewerPage), "text/html; charset=utf-8"); }});
   r.push_back({"GET", "/healthz", "Liveness: the process answers", false, false, {}, nullptr,
                {{"200", "alive"}}, [](RouteContext& c) { c.reply(200, {{"status", "ok"}}); }});
   r.push_back({"GET", "/readyz", "Readiness: sessions loaded and not shutting down", false, false, {}, nullptr,

@@ -38,6 +38,9 @@ Service::Service(ServiceConfig config) : config_(std::move(config)), data_(confi
                                               int(std::max(1u, cores / unsigned(config_.max_jobs))),
                                               [this](Job& job) { run_job(job); });
   load_journal();
+  render_status_ = config_.render == "off"
+                       ? "rendering is off (levelsetd serve --render off)"
+                       : "no offscreen renderer in this build yet (--render " + config_.render + " was asked for)";
   ready_ = true;
 }
 

@@ -61,6 +61,10 @@ class Service {
   bool ready() const { return ready_.load() && !scheduler_->stopping(); }
   std::string metrics() const;      // Prometheus text
   std::vector<std::string> startup_problems() const { return startup_problems_; }
+  // Frames and streams: whether an offscreen GL context renders them, and if not, why (the
+  // frame routes answer 503 with it; everything else works).
+  bool rendering() const { return false; }
+  std::string render_status() const { return render_status_; }
 
   UploadStore& uploads() { return *uploads_; }
   SessionStore& sessions() { return *sessions_; }
@@ -112,6 +116,7 @@ class Service {
   std::unique_ptr<JobScheduler> scheduler_;
   std::atomic<bool> ready_{false};
   std::vector<std::string> startup_problems_;
+  std::string render_status_;
   std::atomic<std::uint64_t> jobs_succeeded_{0}, jobs_failed_{0};
 
   std::mutex cache_mutex_;

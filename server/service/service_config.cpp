@@ -104,6 +104,13 @@ const std::vector<ServiceOption>& service_options() {
        },
        [](const ServiceConfig& c) { return c.log_format; }},
       text("replica", "Prefix of every session and job id (default: the host name)", &ServiceConfig::replica),
+      {"render", "Offscreen rendering for frames and streams: egl, osmesa or off",
+       [](ServiceConfig& c, const std::string& v) {
+         if (v != "egl" && v != "osmesa" && v != "off")
+           bad("render", "expected egl, osmesa or off, found '" + sanitize_utf8(v.substr(0, 40)) + "'");
+         c.render = v;
+       },
+       [](const ServiceConfig& c) { return c.render; }},
       integer("max_jobs", "Jobs running at once (0: one per two cores)", &ServiceConfig::max_jobs, 0, 1024),
       integer("max_queued_jobs", "Jobs waiting; beyond it 429", &ServiceConfig::max_queued_jobs, 0, 100000),
       integer("max_sessions", "Sessions held; beyond it 507", &ServiceConfig::max_sessions, 1, 1000000),

@@ -38,7 +38,15 @@ void check_formula(const json& body) {
   try {
     (void)evolve::speed_from_text(body["speed"].get<std::string>(), body.value("c", 1.0), body.value("eps", 0.1), constants);
   } catch (const Error& e) {
-    throw ApiError::from_error(Error(e.code(), "body.speed (" + e.where() + ")", e.reason()));
+    ApiError api = ApiError::from_error(Error(e.code(), "body.speed (" + e.where() + ")", e.reason()));
+    // The column inside the formula, for clients that point at it (the viewer's caret).
+    json details = api.details();
+    details["field"] = "speed";
+    const std::size_t at = e.where().find("column ");
+    if (at != std::string::npos) details["column"] = std::atoi(e.where().c_str() + at + 7);
+    const std::size_t newline = e.reason().find('\n');
+    details["message"] = e.reason().substr(0, newline);
+    throw ApiError(api.status(), api.code(), api.message(), details);
   }
 }
 

@@ -85,6 +85,11 @@ json Session::snapshots() const {
   return meta_.value("snapshots", json::array());
 }
 
+json Session::view() const {
+  std::lock_guard lock(mutex_);
+  return meta_.value("view", json::object());
+}
+
 bool Session::claim(const std::string& job_id) {
   std::lock_guard lock(mutex_);
   if (!running_job_.empty()) return false;
@@ -278,6 +283,22 @@ void SessionStore::set_preview(Session& s, std::shared_ptr<const NarrowBand> ban
 }
 
 void SessionStore::clear_preview(Session& s) { set_preview(s, nullptr); }
+
+json SessionStore::update_view(Session& s, const json& changes) {
+  json view;
+  {
+    std::lock_guard lock(s.mutex_);
+    json merged = s.meta_.value("view", json::object());
+    merged.merge_patch(changes);
+    if (merged.dump().size() > 16384) throw unprocessable("body", "the view settings are larger than 16 KiB");
+    s.meta_["view"] = merged;
+    write_meta(s);
+    view = merged;
+  }
+  s.preview_serial_.fetch_add(1);  // frames of the session change with its view
+  s.events().publish("view", view);
+  return view;
+}
 
 json SessionStore::snapshot(Session& s, const std::string& replica, const std::string& name) {
   const std::string sid = new_id(replica, 'n');

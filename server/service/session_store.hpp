@@ -48,6 +48,7 @@ class Session {
   nlohmann::json describe() const;  // id, name, version, created, updated, band summary, history size
   nlohmann::json history() const;
   nlohmann::json snapshots() const;
+  nlohmann::json view() const;  // the camera and display settings of this session's frames
   EventLog& events() { return events_; }
 
   // One job at a time: claim() is false when another holds the session.
@@ -84,6 +85,8 @@ class SessionStore {
   // Persists the band as the next version and swaps it in; history gets `entry`.
   std::uint64_t commit(Session& s, NarrowBand band, nlohmann::json entry);
   void set_preview(Session& s, std::shared_ptr<const NarrowBand> band);
+  // Merges `changes` into the session's view settings (kept in session.json); publishes "view".
+  nlohmann::json update_view(Session& s, const nlohmann::json& changes);
   void clear_preview(Session& s);
 
   nlohmann::json snapshot(Session& s, const std::string& replica, const std::string& name);

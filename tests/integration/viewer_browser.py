@@ -1,0 +1,81 @@
+#!/usr/bin/python3
+"""The browser viewer in a real browser: headless Chromium driven by Selenium against a real
+daemon. Loads the page, creates a session from the panel, starts an evolution and sees its
+progress reach 100 %, sees a bad formula's error with a caret under its column, and sees the
+view report why frames are not rendered when they are not.
+
+Usage: viewer_browser.py LEVELSETD SCRATCH_DIR
+"""
+import os
+import shutil
+import sys
+import time
+
+from selenium import webdriver
+from selenium.webdriver.chrome.options import Options
+from selenium.webdriver.chrome.service import Service as ChromeService
+from selenium.webdriver.common.by import By
+from selenium.webdriver.support.ui import WebDriverWait
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from daemon_harness import Daemon  # noqa: E402
+
+BIN, SCRATCH = sys.argv[1], sys.argv[2]
+shutil.rmtree(SCRATCH, ignore_errors=True)
+os.makedirs(SCRATCH)
+
+
+def check(cond, what):
+    if not cond:
+        raise AssertionError(what)
+
+
+options = Options()
+options.binary_location = "/usr/bin/chromium"
+for arg in ("--headless=new", "--no-sandbox", "--disable-gpu", "--disable-dev-shm-usage", "--window-size=1400,900"):
+    options.add_argument(arg)
+d = Daemon(BIN, os.path.join(SCRATCH, "data"))
+driver = webdriver.Chrome(service=ChromeService("/usr/bin/chromedriver"), options=options)
+wait = WebDriverWait(driver, 60)
+try:
+    driver.get(d.url + "/")
+    check(driver.title == "levelsetd viewer", f"page title: {driver.title}")
+    # A session from the panel; it appears in the list, selected.
+    driver.find_element(By.ID, "shape").send_keys("torus")
+    res = driver.find_element(By.ID, "resolution")
+    res.clear()
+    res.send_keys("48")
+    driver.find_element(By.ID, "create").click()
+    wait.until(lambda _: driver.find_elements(By.CSS_SELECTOR, "#sessions li.selected"))
+    sessions = d.get("/api/v1/sessions")[2]["sessions"]
+    check(len(sessions) == 1, f"one session created: {sessions}")
+    # An evolution: its card's progress reaches 100 % and the job succeeds.
+    formula = driver.find_element(By.ID, "formula")
+    formula.clear()
+    formula.send_keys("-(k1+k2)")
+    steps = driver.find_element(By.ID, "steps")
+    steps.clear()
+    steps.send_keys("40")
+    driver.find_element(By.ID, "start").click()
+    wait.until(lambda _: driver.find_elements(By.CSS_SELECTOR, ".job .state"))
+    wait.until(lambda _: driver.find_element(By.CSS_SELECTOR, ".job .state").text == "succeeded")
+    pct = driver.find_element(By.CSS_SELECTOR, ".job .pct").text
+    width = driver.find_element(By.CSS_SELECTOR, ".job .bar > div").get_attribute("style")
+    check(pct == "100 %" and "100%" in width, f"progress at the end: {pct}, {width}")
+    check(d.get(f"/api/v1/sessions/{sessions[0]['id']}")[2]["version"] == 2, "the job committed version 2")
+    # A bad formula: the server's error, with the caret under the column it names.
+    formula.clear()
+    formula.send_keys("1 + * k1")
+    driver.find_element(By.ID, "start").click()
+    wait.until(lambda _: driver.find_element(By.ID, "formula-error").text.strip())
+    lines = driver.find_element(By.ID, "formula-error").text.split("\n")
+    check(lines[0] == "1 + * k1" and lines[1].index("^") == 4, f"formula error: {lines}")
+    # No renderer: the view says why instead of showing a broken image.
+    wait.until(lambda _: driver.find_element(By.ID, "view-message").text)
+    message = driver.find_element(By.ID, "view-message").text
+    check("render" in message, f"view message: {message}")
+    driver.save_screenshot(os.path.join(SCRATCH, "viewer.png"))
+finally:
+    driver.quit()
+    d.stop()
+print("viewer_browser: the page created a session, ran a job to 100 %, showed a formula error at its column")
