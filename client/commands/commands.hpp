@@ -27,6 +27,9 @@ void add_run_command(CLI::App& app, Globals& g);
 
 // Helpers shared by the commands.
 void print_json(const nlohmann::json& j);  // pretty, to stdout
+// Applies "a.b=value" to a request body (nested objects for dotted keys; the value as JSON when
+// it parses: numbers, true, [1, 2]; else as a string). ClientError{Usage} when malformed.
+void apply_param(nlohmann::json& body, const std::string& assignment);
 // Follows a job to its end, progress on stderr (and its log lines when `logs`); returns the
 // final description; ClientError unless it succeeded.
 nlohmann::json wait_for_job(const Api& api, const std::string& job_id, bool logs,

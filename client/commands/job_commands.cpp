@@ -21,6 +21,8 @@ struct JobArgs {
 
 std::string job_path(const std::string& id) { return "/api/v1/jobs/" + Api::encode(id); }
 
+}  // namespace
+
 // "a.b=value": value as JSON when it parses (numbers, true, [1,2]), else as a string.
 void apply_param(json& body, const std::string& assignment) {
   const std::size_t eq = assignment.find('=');
@@ -45,7 +47,6 @@ void apply_param(json& body, const std::string& assignment) {
   }
 }
 
-}  // namespace
 
 json wait_for_job(const Api& api, const std::string& job_id, bool logs, ProgressView::Mode mode) {
   ProgressView view(mode);

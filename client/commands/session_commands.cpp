@@ -1,4 +1,4 @@
-// sessions list | create (--primitive NAME [--resolution N] | --upload ID) [--name N] [--wait]
+// sessions list | create (--primitive NAME | --upload ID [--param k=v ...]) [--resolution N] [--name N] [--wait]
 //          | show ID | delete ID | snapshot ID [--name N]
 #include <cstdio>
 #include <memory>
@@ -14,6 +14,7 @@ namespace {
 
 struct SessionArgs {
   std::string id, primitive, upload, name;
+  std::vector<std::string> params;
   int resolution = 0;
   bool json = false, wait = false;
 };
@@ -43,11 +44,12 @@ void add_session_commands(CLI::App& app, Globals& g) {
 
   CLI::App* create = s->add_subcommand("create", "Create a session from a built-in shape or an upload; prints its id");
   auto* prim = create->add_option("--primitive", a->primitive, "Built-in shape (sphere box torus dumbbell knot)");
-  create->add_option("--resolution", a->resolution, "Voxels along the longest side (with --primitive)")
-      ->check(CLI::Range(8, 4096))
-      ->needs(prim);
+  create->add_option("--resolution", a->resolution, "Voxels along the longest side (raster.resolution)")
+      ->check(CLI::Range(8, 4096));
   auto* up = create->add_option("--upload", a->upload, "Upload id (a mesh, points, an image or an .lsg)");
   prim->excludes(up);
+  create->add_option("--param", a->params, "With --upload: a parameter of the job that makes the session, key=value")
+      ->allow_extra_args(false);
   create->add_option("--name", a->name, "Session name");
   create->add_flag("--wait", a->wait, "When a job creates the session (uploads of meshes), wait for it");
   create->callback([a, &g] {
@@ -56,10 +58,13 @@ void add_session_commands(CLI::App& app, Globals& g) {
     json body = json::object();
     if (!a->primitive.empty()) {
       body["primitive"] = a->primitive;
-      if (a->resolution > 0) body["raster"] = {{"resolution", a->resolution}};
+      if (!a->params.empty())
+        throw ClientError(ClientError::Kind::Usage, "usage", "--param goes with --upload (a primitive takes --resolution)");
     } else {
       body["upload"] = a->upload;
+      for (const std::string& p : a->params) apply_param(body, p);
     }
+    if (a->resolution > 0) body["raster"]["resolution"] = a->resolution;
     if (!a->name.empty()) body["name"] = a->name;
     const Api api = g.api();
     int status = 0;

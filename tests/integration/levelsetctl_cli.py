@@ -14,7 +14,8 @@ Scenarios:
             returns 0 on success, non-zero for a cancelled job; SIGTERM to `run` cancels its job;
             a wait through a proxy that cuts
             the event stream resumes with Last-Event-ID (no log line lost or repeated); uploads
-            of malformed files are refused with the server's message; downloads equal the API's.
+            of malformed files are refused with the server's message; downloads equal the API's;
+            the README's levelsetctl walk-through runs as written.
 Missing binaries, data or job sizes fail the test; nothing is skipped.
 """
 import filecmp
@@ -273,7 +274,28 @@ def step_lines(text):
     return [int(m) for m in re.findall(r"^\[ *[0-9.]+ s\] step (\d+) ", text, re.M)]
 
 
-def scenario_commands(ctx, cgal):
+def readme_block(ctx, readme, jobs_dir):
+    """The README's levelsetctl walk-through, run as written (bash -euo pipefail) with
+    levelsetctl on PATH, from a folder where configs/ is the repository's."""
+    text = open(readme).read()
+    m = re.search(r"The same with `levelsetctl`.*?```sh\n(.*?)```", text, re.S)
+    check(m is not None, f"no levelsetctl walk-through in {readme}")
+    work = os.path.join(ctx.scratch, "readme")
+    os.makedirs(work)
+    os.symlink(os.path.dirname(jobs_dir), os.path.join(work, "configs"))
+    env = dict(ctx.env, LEVELSET_URL=ctx.url, PATH=os.path.dirname(ctx.ctl) + os.pathsep + ctx.env["PATH"])
+    p = subprocess.run(["bash", "-euo", "pipefail", "-c", m.group(1)], cwd=work, capture_output=True, text=True,
+                       env=env, timeout=240)
+    check(p.returncode == 0, f"the README's levelsetctl block failed ({p.returncode}):\n{p.stdout}\n{p.stderr}")
+    check(p.stdout.rstrip().endswith("exit 1") and "levelsetctl: " in p.stderr, f"README block: {p.stdout[-200:]}")
+    for f in ("torus.ply", "kitten.off", "out/offset_knot.ply", "out/offset_knot.lsg"):
+        check(os.path.getsize(os.path.join(work, f)) > 0, f"README block: no {f}")
+    check(json.load(open(os.path.join(work, "evolve.json")))["evolution"]["steps"] == 60, "README block: evolve.json")
+
+
+def scenario_commands(ctx, cgal, readme, jobs_dir):
+    readme_block(ctx, readme, jobs_dir)
+
     # Usage, no server.
     ctx.refused([], 2, "usage")
     ctx.refused(["jobs", "submit"], 2, "usage")
@@ -442,7 +464,8 @@ def scenario_commands(ctx, cgal):
     ctx.refused(["upload", bad, "--format", "nope"], 1, "unsupported_format")
     ctx.refused(["upload", os.path.join(ctx.scratch, "a.vtk")], 2, "unknown_format")
     # A session from the upload (a job makes it): --wait prints the session.
-    sid2 = ctx.ok(["sessions", "create", "--upload", uid, "--wait"]).stdout.strip()
+    ctx.refused(["sessions", "create", "--primitive", "box", "--param", "a=1"], 2, "usage")
+    sid2 = ctx.ok(["sessions", "create", "--upload", uid, "--param", "raster.resolution=32", "--wait"]).stdout.strip()
     check(re.fullmatch(r"[a-z0-9-]+-s-[0-9a-f]{16}", sid2) is not None, f"session from an upload: {sid2!r}")
     ctx.ok(["sessions", "delete", sid2])
     ctx.refused(["sessions", "show", sid2], 1, "not_found")
@@ -472,7 +495,8 @@ def main():
         if scenario == "jobs":
             scenario_jobs(ctx, cgal, jobs_dir)
         elif scenario == "commands":
-            scenario_commands(ctx, cgal)
+            scenario_commands(ctx, cgal, os.path.join(os.path.dirname(os.path.dirname(jobs_dir)), "README.md"),
+                              jobs_dir)
         else:
             fail(f"unknown scenario {scenario}")
     except Failure as e:
