@@ -71,7 +71,7 @@ json Session::describe() const {
             {"history_length", meta_.value("history", json::array()).size()},
             {"snapshots", meta_.value("snapshots", json::array()).size()},
             {"running_job", running_job_.empty() ? json(nullptr) : json(running_job_)}};
-  if (band_) j["band"] = band_summary(*band_);
+  if (band_) j["band"] = summary_;
   return j;
 }
 
@@ -134,6 +134,7 @@ std::vector<std::string> SessionStore::load_all() {
         throw Error(ErrorCode::Corrupt, (d.path() / "session.json").string(), "no band file named");
       auto s = std::make_shared<Session>(id, d.path());
       s->band_ = std::make_shared<const NarrowBand>(load_lsg(d.path() / band_file).band);
+      s->summary_ = band_summary(*s->band_);
       s->meta_ = std::move(meta);
       // Leftovers of a commit cut short: band files other than the named one.
       for (const fs::directory_entry& f : fs::directory_iterator(d.path(), ec)) {
@@ -200,6 +201,7 @@ std::shared_ptr<Session> SessionStore::create(const std::string& replica, const 
     throw;
   }
   s->band_ = std::make_shared<const NarrowBand>(std::move(band));
+  s->summary_ = band_summary(*s->band_);
   std::lock_guard lock(mutex_);
   sessions_[id] = s;
   return s;
@@ -267,6 +269,7 @@ std::uint64_t SessionStore::commit(Session& s, NarrowBand band, json entry) {
     std::error_code ec;
     if (!old_file.empty() && old_file != file) fs::remove(s.dir_ / old_file, ec);
     s.band_ = std::make_shared<const NarrowBand>(std::move(band));
+    s.summary_ = band_summary(*s.band_);
     s.preview_.reset();
   }
   s.preview_serial_.fetch_add(1);

@@ -63,6 +63,7 @@ class Session {
   std::filesystem::path dir_;
   nlohmann::json meta_ = nlohmann::json::object();  // what session.json holds
   std::shared_ptr<const NarrowBand> band_, preview_;
+  nlohmann::json summary_;  // band_summary(*band_), computed once per version (GETs are hot)
   std::atomic<std::uint64_t> preview_serial_{0};
   std::string running_job_;
   EventLog events_;

@@ -67,7 +67,7 @@ try:
     url = f"{d.url}/api/v1/sessions/{big['id']}/mesh?format=ply"
     ttfb_cold, total_cold, size = download(url)
     ttfb_warm, total_warm, _ = download(url)
-    triangles = (size - 300) // 49  # binary PLY: 3 doubles a vertex (~0.5 per triangle), 13 bytes a face
+    triangles = (size - 300) // 25  # binary PLY: 24 bytes a vertex (~0.5 per triangle), 13 bytes a face
     print(f"mesh download, sphere at resolution {resolution} (~{triangles / 1e6:.2f}M triangles, {size / 1e6:.1f} MB PLY): "
           f"cold TTFB {ttfb_cold * 1e3:.0f} ms, total {total_cold:.2f} s; warm TTFB {ttfb_warm * 1e3:.1f} ms, "
           f"total {total_warm:.3f} s, {size / 1e6 / max(total_warm, 1e-9):.0f} MB/s")
