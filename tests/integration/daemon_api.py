@@ -152,6 +152,40 @@ def test_reconstruct_kitten():
         d.stop()
 
 
+def test_sessions_from_uploads():
+    """A session from each kind of upload: a band at once, a mesh by CPT, an image by segmentation."""
+    work = fresh("uploads")
+    d = Daemon(BIN, work)
+    try:
+        band = os.path.join(SCRATCH, "uploads-torus.lsg")
+        subprocess.run([BIN, "primitive", "torus", "-r", "32", "-o", band], check=True, capture_output=True)
+        status, _, up = upload(d, band, "lsg")
+        check(status == 201 and up["kind"] == "band", f"band upload: {status} {up}")
+        status, hdrs, s = d.post("/api/v1/sessions", {"upload": up["id"], "name": "torus"})
+        check(status == 201 and s["name"] == "torus" and hdrs["Location"].endswith(s["id"]), f"from a band: {s}")
+        status, _, up = upload(d, os.path.join(CGAL, "meshes", "knot1.off"), "off")
+        check(status == 201 and up["kind"] == "mesh" and up["summary"]["triangles"] > 1000, f"mesh upload: {up}")
+        status, _, job = d.post("/api/v1/sessions", {"upload": up["id"], "raster": {"resolution": 48}})
+        final = d.wait_job(job["id"])
+        check(final["state"] == "succeeded" and final["op"] == "cpt", f"from a mesh: {final}")
+        mesh = off_topology(d.request("GET", f"/api/v1/sessions/{final['result']['session']}/mesh?format=off")[2].decode())
+        check(mesh[2] and mesh[3] == 1, f"the knot's CPT surface: watertight, genus 1: {mesh}")
+        status, _, up = upload(d, os.path.join(CGAL, "images", "liver.inr.gz"), "inr")
+        check(status == 201 and up["kind"] == "image", f"image upload: {up}")
+        status, _, job = d.post("/api/v1/sessions", {"upload": up["id"], "input": {"downsample": 4}, "seed_above": 127.5})
+        final = d.wait_job(job["id"])
+        check(final["state"] == "succeeded" and final["op"] == "segment", f"from an image: {final.get('error')}")
+        status, _, body = d.get(f"/api/v1/uploads/{up['id']}")
+        check(status == 200 and body["id"] == up["id"], "GET an upload")
+        check(d.json_request("DELETE", f"/api/v1/uploads/{up['id']}")[0] == 204, "DELETE an upload")
+        check(d.get(f"/api/v1/uploads/{up['id']}")[0] == 404, "a deleted upload is gone")
+        status, _, body = d.json_request("POST", "/api/v1/uploads?format=exe", b"MZ",
+                                         headers={"Content-Type": "application/octet-stream"})
+        check(status == 415, f"unknown upload format: {status}")
+    finally:
+        d.stop()
+
+
 def test_knot_job_file():
     """A job file over the API: the shipped knot reconstruction, its final band a session."""
     d = Daemon(BIN, fresh("knotjob"))
