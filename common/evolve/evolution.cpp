@@ -26,6 +26,9 @@
 
 namespace levelset::evolve {
 
+// The observer of every evolution on this thread (StepObserverScope); null when none.
+thread_local const std::function<void(const StepInfo&)>* t_step_observer = nullptr;
+
 namespace {
 
 using Clock = std::chrono::steady_clock;
@@ -882,6 +885,7 @@ EvolutionResult evolve(const NarrowBand& band, const EvolutionOptions& options) 
     info.crossings = op.crossings;
     info.band = &cur;
     if (options.on_step) options.on_step(info);
+    if (t_step_observer != nullptr) (*t_step_observer)(info);
     if (options.progress.on_progress) {
       const double f = options.steps > 0 ? double(step) / options.steps : t / options.time;
       options.progress.on_progress(std::min(1.0, f), "evolve");
@@ -906,6 +910,13 @@ EvolutionResult evolve(const NarrowBand& band, const EvolutionOptions& options) 
   result.seconds.total = since(start);
   return result;
 }
+
+StepObserverScope::StepObserverScope(std::function<void(const StepInfo&)> observer)
+    : observer_(std::move(observer)), previous_(t_step_observer) {
+  t_step_observer = &observer_;
+}
+
+StepObserverScope::~StepObserverScope() { t_step_observer = previous_; }
 
 void throw_if_stopped(const EvolutionResult& result, const std::string& where) {
   if (result.stop == StopReason::Cancelled) throw Error(ErrorCode::Cancelled, where, "operation cancelled");

@@ -95,6 +95,23 @@ struct StepInfo {
   const NarrowBand* band = nullptr;
 };
 
+// StepObserverScope: while it lives, every evolution run on the calling thread reports each
+// step to `observer` too (after options.on_step). The daemon watches jobs with it whose
+// applications run the evolution inside (offset, fairing, min/max, CSG seams, reconstruction,
+// segmentation) to publish live previews without a hook in each application's options.
+// Scopes nest; the innermost observes. Not copyable; thread-local by design.
+class StepObserverScope {
+ public:
+  explicit StepObserverScope(std::function<void(const StepInfo&)> observer);
+  ~StepObserverScope();
+  StepObserverScope(const StepObserverScope&) = delete;
+  StepObserverScope& operator=(const StepObserverScope&) = delete;
+
+ private:
+  std::function<void(const StepInfo&)> observer_;
+  const std::function<void(const StepInfo&)>* previous_;
+};
+
 // Default drift tolerance: redistance once the mean ||grad u| - 1| near the front passes it.
 // Measured on mean-curvature flow of a sphere to half its radius (R = 64 and 128): 0.02-0.1
 // all keep the radius within 0.5 % of sqrt(r0^2 - 4t); without it the flow's own stretching

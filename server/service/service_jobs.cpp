@@ -270,12 +270,20 @@ void Service::run_job(Job& job) {
   // For progress only; the operation validates these (a string here is its 422, not ours).
   const int total_steps = request.contains("steps") && request["steps"].is_number() ? request["steps"].get<int>() : 0;
   const double total_time = request.contains("time") && request["time"].is_number() ? request["time"].get<double>() : 0.0;
-  ctx.on_step = [&](const evolve::StepInfo& info) {
+  // Every evolution the operation runs reports its steps here (evolve::StepObserverScope):
+  // previews for all of them; steps, time, ETA and checkpoints for the evolve op, whose steps
+  // and time are the request's own (other applications evolve in chunks and levels).
+  const bool stepwise = request.value("op", "") == "evolve";
+  auto on_step = [&](const evolve::StepInfo& info) {
     const auto now = Clock::now();
     const double elapsed = std::chrono::duration<double>(now - started).count();
     double fraction = total_steps > 0 ? double(info.step) / total_steps : total_time > 0 ? info.time / total_time : 0.0;
     fraction = std::min(1.0, fraction);
-    if (now - last_progress >= std::chrono::milliseconds(50)) {
+    if (!stepwise && now - last_progress >= std::chrono::milliseconds(50)) {
+      last_progress = now;
+      job.set_progress({{"dt", info.dt}, {"active_voxels", info.active_voxels}});
+    }
+    if (stepwise && now - last_progress >= std::chrono::milliseconds(50)) {
       last_progress = now;
       job.set_progress({{"fraction", fraction},
                         {"stage", "evolve"},
@@ -290,7 +298,7 @@ void Service::run_job(Job& job) {
         last_preview = now;
         sessions_->set_preview(*session, std::make_shared<const NarrowBand>(*info.band));
       }
-      if (config_.checkpoint_seconds > 0 &&
+      if (stepwise && config_.checkpoint_seconds > 0 &&
           now - last_checkpoint >= std::chrono::duration<double>(config_.checkpoint_seconds)) {
         last_checkpoint = now;
         sessions_->save_checkpoint(*session, job.id(), *info.band,
@@ -309,6 +317,7 @@ void Service::run_job(Job& job) {
     job.events().close();
   };
   try {
+    evolve::StepObserverScope observe(on_step);
     OperationResult r;
     if (request.value("op", "") == "job") {
       config::ParseOptions po;
@@ -340,7 +349,7 @@ void Service::run_job(Job& job) {
     }
     if (job.shutting_down && r.stopped) {
       // The shutdown stopped it: keep the state reached as a checkpoint, resumable.
-      if (session && r.band) {
+      if (session && r.band && stepwise) {  // others resume from their start
         const int done = r.result.value("evolution", json::object()).value("steps", 0);
         const double t = r.result.value("evolution", json::object()).value("time", 0.0);
         sessions_->save_checkpoint(*session, job.id(), *r.band,

@@ -512,6 +512,20 @@ def test_preview_while_running():
         d.wait_job(job["id"])
         _, h3, m3 = d.request("GET", f"/api/v1/sessions/{s['id']}/mesh?format=off")
         check(h3["ETag"] not in (h1["ETag"], h2["ETag"]), "after the cancel the mesh is the committed one again")
+        # An application that evolves inside (fairing) previews too.
+        status, _, job = d.post(f"/api/v1/sessions/{s['id']}/jobs", {"op": "fair", "flow": "mean-curvature",
+                                                                    "steps": 100000})
+        check(status == 202, f"fair: {status} {job}")
+        seen = set()
+        for _ in range(100):
+            _, h, _ = d.request("GET", f"/api/v1/sessions/{s['id']}/mesh?format=off")
+            seen.add(h["ETag"])
+            if len(seen) >= 3:
+                break
+            d.events(f"/api/v1/jobs/{job['id']}/events", until=lambda e: e[1] == "progress", timeout=30)
+        check(len(seen) >= 3, f"the fairing's preview moves: {len(seen)} distinct meshes")
+        d.json_request("DELETE", f"/api/v1/jobs/{job['id']}")
+        check(d.wait_job(job["id"])["state"] == "cancelled", "fairing cancelled")
     finally:
         d.stop()
 
