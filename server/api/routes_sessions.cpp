@@ -1,6 +1,8 @@
 // Uploads and sessions: create (primitive, band upload, or a first job), list, show, rename,
 // delete, snapshots, events, and the results (mesh, band, voxels).
+#include <chrono>
 #include <cstdlib>
+#include <thread>
 
 #include "api/route.hpp"
 #include "service/api_error.hpp"
@@ -27,6 +29,75 @@ double query_number(const httplib::Request& req, const char* name, double fallba
 
 std::string query_text(const httplib::Request& req, const char* name, const std::string& fallback) {
   return req.has_param(name) ? req.get_param_value(name).substr(0, 200) : fallback;
+}
+
+// width, height, format, quality; every other parameter is a view setting for the renderer.
+service::FrameRequest frame_settings(const httplib::Request& req) {
+  service::FrameRequest f;
+  f.width = int(query_number(req, "width", 800));
+  f.height = int(query_number(req, "height", 600));
+  f.quality = int(query_number(req, "quality", 85));
+  f.format = query_text(req, "format", "jpeg");
+  if (f.format == "jpg") f.format = "jpeg";
+  for (const auto& [key, value] : req.params)
+    if (key != "width" && key != "height" && key != "quality" && key != "format" && key != "access_token")
+      f.query.emplace_back(key.substr(0, 64), value.substr(0, 256));
+  return f;
+}
+
+// MJPEG: a new part whenever the session's state (a step, a version) or view changed, at most
+// 15 a second; the provider draws the newest state when the client is ready for it, so a slow
+// client skips frames instead of queueing them.
+void stream_frames(RouteContext& c) {
+  service::Service& svc = c.service;
+  auto session = svc.sessions().get(c.param(1));
+  if (!svc.rendering()) throw ApiError(503, "rendering_off", svc.render_status());
+  if (int(svc.streams_open.load()) >= svc.config().max_streams)
+    throw ApiError(503, "too_many_streams", "the server holds " + std::to_string(svc.config().max_streams) +
+                                                " open streams (max_streams); retry later");
+  service::FrameRequest settings = frame_settings(c.req);
+  settings.format = "jpeg";
+  struct Cursor {
+    std::uint64_t state = ~std::uint64_t{0};
+    std::chrono::steady_clock::time_point last{};
+  };
+  auto cursor = std::make_shared<Cursor>();
+  ++svc.streams_open;
+  c.res.set_header("Cache-Control", "no-cache");
+  c.res.set_chunked_content_provider(
+      "multipart/x-mixed-replace; boundary=levelsetframe",
+      [&svc, session, settings, cursor](std::size_t, httplib::DataSink& sink) {
+        const auto min_gap = std::chrono::milliseconds(1000 / 15);
+        for (int waited = 0; waited < 10; ++waited) {  // at most ~1 s in one call
+          if (!svc.ready()) {
+            sink.done();
+            return true;
+          }
+          const std::uint64_t now_state = session->preview_serial() * 1000003 + session->view_serial();
+          if (now_state != cursor->state) {
+            const auto since = std::chrono::steady_clock::now() - cursor->last;
+            if (since < min_gap) std::this_thread::sleep_for(min_gap - since);
+            std::uint64_t drawn = 0;
+            service::EncodedFrame f;
+            try {
+              f = svc.frame(session->id(), settings, &drawn);
+            } catch (const std::exception&) {
+              return false;  // the session went away or the renderer stopped: end the stream
+            }
+            const std::string head = "--levelsetframe\r\nContent-Type: image/jpeg\r\nContent-Length: " +
+                                     std::to_string(f.bytes->size()) + "\r\n\r\n";
+            if (!sink.write(head.data(), head.size()) || !sink.write(f.bytes->data(), f.bytes->size()) ||
+                !sink.write("\r\n", 2))
+              return false;
+            cursor->state = drawn;
+            cursor->last = std::chrono::steady_clock::now();
+            return true;
+          }
+          session->events().wait_after(session->events().last_id(), std::chrono::milliseconds(100));
+        }
+        return true;
+      },
+      [&svc](bool) { --svc.streams_open; });
 }
 
 void upload(RouteContext& c) {
@@ -119,19 +190,20 @@ void add_session_routes(std::vector<Route>& r) {
                  auto s = c.service.sessions().get(c.param(1));
                  c.reply(200, c.service.sessions().update_view(*s, body));
                }});
-  for (const char* what : {"frame", "stream"}) {
-    const bool stream = std::string(what) == "stream";
-    r.push_back({"GET", std::string("/api/v1/sessions/{id}/") + what,
-                 stream ? "The session rendered live as MJPEG (multipart/x-mixed-replace)"
-                        : "The session rendered offscreen as PNG or JPEG",
-                 false, false, {"width", "height", "format", "quality", "shading"}, nullptr,
-                 {{"200", stream ? "multipart/x-mixed-replace stream" : "the image"}, {"422", "a size or setting out of range"},
-                  {"503", "rendering is off or unavailable"}},
-                 [](RouteContext& c) {
-                   c.service.sessions().get(c.param(1));
-                   if (!c.service.rendering()) throw ApiError(503, "rendering_off", c.service.render_status());
-                 }});
-  }
+  r.push_back({"GET", "/api/v1/sessions/{id}/frame",
+               "The session rendered offscreen (its view, then the query's settings over it) as JPEG or PNG", false,
+               false, {"width", "height", "format", "quality", "shading", "yaw", "pitch", "zoom", "slice", "volume"},
+               nullptr, {{"200", "the image"}, {"422", "a size or setting out of range"}, {"503", "rendering is off"}},
+               [](RouteContext& c) {
+                 const service::EncodedFrame f = c.service.frame(c.param(1), frame_settings(c.req));
+                 c.res.set_content(std::string(*f.bytes), f.content_type);
+               }});
+  r.push_back({"GET", "/api/v1/sessions/{id}/stream",
+               "The session rendered live as MJPEG (multipart/x-mixed-replace): a frame after every step, view or "
+               "version change, at most max_fps a second; a slow client gets the newest frame",
+               false, false, {"width", "height", "quality", "shading", "yaw", "pitch", "zoom", "slice", "volume"}, nullptr,
+               {{"200", "multipart/x-mixed-replace; boundary=levelsetframe"}, {"503", "rendering is off or too many streams"}},
+               stream_frames});
   // ---- results
   r.push_back({"GET", "/api/v1/sessions/{id}/mesh", "The surface as a mesh (chunked; ETag from version and query)",
                false, false, {"iso", "method", "format"}, nullptr,

@@ -38,13 +38,25 @@ Service::Service(ServiceConfig config) : config_(std::move(config)), data_(confi
                                               int(std::max(1u, cores / unsigned(config_.max_jobs))),
                                               [this](Job& job) { run_job(job); });
   load_journal();
-  render_status_ = config_.render == "off"
-                       ? "rendering is off (levelsetd serve --render off)"
-                       : "no offscreen renderer in this build yet (--render " + config_.render + " was asked for)";
+  render_ = std::make_unique<RenderService>(config_.render, default_renderer_factory());
   ready_ = true;
 }
 
 Service::~Service() { shutdown(std::chrono::steady_clock::now()); }
+
+bool Service::rendering() const { return render_->available(); }
+std::string Service::render_status() const { return render_->status(); }
+
+EncodedFrame Service::frame(const std::string& session_id, const FrameRequest& settings, std::uint64_t* state) {
+  auto s = sessions_->get(session_id);
+  FrameRequest r = settings;
+  const std::uint64_t serial = s->preview_serial();
+  r.band = s->preview();
+  r.view = s->view();
+  r.scene_key = session_id + "-v" + std::to_string(s->version()) + "-p" + std::to_string(serial);
+  if (state != nullptr) *state = serial * 1000003 + s->view_serial();
+  return render_->render(std::move(r), std::chrono::seconds(30));
+}
 
 void Service::shutdown(std::chrono::steady_clock::time_point deadline) {
   ready_ = false;

@@ -23,6 +23,7 @@
 #include <nlohmann/json.hpp>
 
 #include "service/job_scheduler.hpp"
+#include "service/render_service.hpp"
 #include "service/service_config.hpp"
 #include "service/session_store.hpp"
 #include "service/upload_store.hpp"
@@ -63,8 +64,12 @@ class Service {
   std::vector<std::string> startup_problems() const { return startup_problems_; }
   // Frames and streams: whether an offscreen GL context renders them, and if not, why (the
   // frame routes answer 503 with it; everything else works).
-  bool rendering() const { return false; }
-  std::string render_status() const { return render_status_; }
+  bool rendering() const;
+  std::string render_status() const;
+  // A frame of the session's current state (its preview while a job runs) with its view and
+  // the query's settings over it; `state` says which state was drawn (for streams).
+  EncodedFrame frame(const std::string& session_id, const FrameRequest& settings, std::uint64_t* state = nullptr);
+  RenderService& renderer() { return *render_; }
 
   UploadStore& uploads() { return *uploads_; }
   SessionStore& sessions() { return *sessions_; }
@@ -116,7 +121,7 @@ class Service {
   std::unique_ptr<JobScheduler> scheduler_;
   std::atomic<bool> ready_{false};
   std::vector<std::string> startup_problems_;
-  std::string render_status_;
+  std::unique_ptr<RenderService> render_;
   std::atomic<std::uint64_t> jobs_succeeded_{0}, jobs_failed_{0};
 
   std::mutex cache_mutex_;

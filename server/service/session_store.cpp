@@ -298,7 +298,7 @@ json SessionStore::update_view(Session& s, const json& changes) {
     write_meta(s);
     view = merged;
   }
-  s.preview_serial_.fetch_add(1);  // frames of the session change with its view
+  s.view_serial_.fetch_add(1);  // streams redraw
   s.events().publish("view", view);
   return view;
 }

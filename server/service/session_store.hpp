@@ -44,7 +44,8 @@ class Session {
   std::shared_ptr<const NarrowBand> band() const;
   std::shared_ptr<const NarrowBand> preview() const;  // the running job's latest step, else band()
   std::uint64_t version() const;
-  std::uint64_t preview_serial() const { return preview_serial_.load(); }
+  std::uint64_t preview_serial() const { return preview_serial_.load(); }  // changes with the band state
+  std::uint64_t view_serial() const { return view_serial_.load(); }        // changes with the view
   nlohmann::json describe() const;  // id, name, version, created, updated, band summary, history size
   nlohmann::json history() const;
   nlohmann::json snapshots() const;
@@ -64,7 +65,7 @@ class Session {
   nlohmann::json meta_ = nlohmann::json::object();  // what session.json holds
   std::shared_ptr<const NarrowBand> band_, preview_;
   nlohmann::json summary_;  // band_summary(*band_), computed once per version (GETs are hot)
-  std::atomic<std::uint64_t> preview_serial_{0};
+  std::atomic<std::uint64_t> preview_serial_{0}, view_serial_{0};
   std::string running_job_;
   EventLog events_;
 };

@@ -1,0 +1,8 @@
+// Builds without levelset_render: no renderer; the frame routes answer 503 and say so.
+#include "service/render_service.hpp"
+
+namespace levelset::service {
+
+RendererFactory default_renderer_factory() { return {}; }
+
+}  // namespace levelset::service
