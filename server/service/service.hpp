@@ -106,6 +106,7 @@ class Service {
   std::atomic<std::uint64_t> requests_total{0}, request_errors_total{0}, streams_open{0};
 
  private:
+  class JobRun;  // service_runner.cpp
   void run_job(Job& job);
   void load_journal();
   std::shared_ptr<Job> make_job(const nlohmann::json& request, const std::string& session_id);
