@@ -148,94 +148,10 @@ void HttpServer::install() {
     listen_fd_ = fd;
   });
 
-  const bool json_log = c.log_format == "json";
   for (const Route& route : api_routes()) {
     const std::string pattern = route_regex(route.path);
-    auto run = [this, &route, json_log](const httplib::Request& req, httplib::Response& res,
-                                        const httplib::ContentReader* reader) {
-      const auto t0 = std::chrono::steady_clock::now();
-      const std::string request_id = request_id_of(req);
-      res.set_header("X-Request-Id", request_id);
-      const service::ServiceConfig& cfg = service_.config();
-      if (!cfg.cors_origin.empty() && req.get_header_value("Origin") == cfg.cors_origin)
-        res.set_header("Access-Control-Allow-Origin", cfg.cors_origin);
-      std::string idempotency;
-      bool replayed = false;
-      try {
-        // Authentication: tokens when configured (always beyond loopback); probes stay open.
-        // Probes, and the viewer page (static; the token is typed into it), need no token.
-        const bool probe = route.path == "/healthz" || route.path == "/readyz" || route.path == "/";
-        if (!tokens_.empty() && !probe) {
-          const std::string auth = req.get_header_value("Authorization");
-          const Role* role = nullptr;
-          // Browsers cannot set headers on <img> and EventSource: GET routes also take
-          // ?access_token=.
-          std::string given;
-          if (auth.rfind("Bearer ", 0) == 0) given = auth.substr(7);
-          else if (route.method == "GET" && req.has_param("access_token")) given = req.get_param_value("access_token");
-          if (!given.empty()) {
-            for (const auto& [token, r] : tokens_)
-              if (same_token(given, token)) role = &r;
-          }
-          if (role == nullptr) throw ApiError(401, "unauthorized", "a valid bearer token is required");
-          if (route.writes && *role == Role::ReadOnly)
-            throw ApiError(403, "forbidden", "this token is read-only; " + route.method + " needs a read-write token");
-        }
-        if (route.writes && !service_.ready()) throw ApiError(503, "shutting_down", "the server is shutting down");
-        if (route.method == "POST" && req.has_header("Idempotency-Key")) {
-          idempotency = req.get_header_value("Authorization") + "|" + req.path + "|" +
-                        req.get_header_value("Idempotency-Key").substr(0, 200);
-          if (auto previous = service_.replay(idempotency)) {
-            res.status = previous->first;
-            res.set_content(previous->second, "application/json");
-            res.set_header("Idempotent-Replayed", "true");
-            idempotency.clear();
-            replayed = true;
-          }
-        }
-        RouteContext ctx{service_, req, res, nullptr, {}};
-        if (replayed) {
-        } else if (reader != nullptr && route.streams_body) {
-          ctx.reader = reader;
-        } else if (reader != nullptr) {
-          const std::uint64_t limit = cfg.max_body_bytes;
-          const std::string length = req.get_header_value("Content-Length");
-          if (!length.empty() && std::strtoull(length.c_str(), nullptr, 10) > limit)
-            throw ApiError(413, "payload_too_large", "the body has " + length + " bytes, more than max_body_bytes (" +
-                                                         std::to_string(limit) + ")");
-          bool over = false;
-          (*reader)([&](const char* data, std::size_t n) {
-            if (ctx.body_text.size() + n > limit) {
-              over = true;
-              return false;
-            }
-            ctx.body_text.append(data, n);
-            return true;
-          });
-          if (over) throw ApiError(413, "payload_too_large", "the body is larger than max_body_bytes (" + std::to_string(limit) + ")");
-        }
-        if (!replayed) run_handler(route, ctx);
-      } catch (const ApiError& e) {
-        write_error(res, e);
-      } catch (const Error& e) {
-        write_error(res, ApiError::from_error(e));
-      } catch (const std::bad_alloc&) {
-        write_error(res, ApiError(507, "out_of_memory", "the server ran out of memory for this request"));
-      } catch (const std::exception& e) {
-        write_error(res, ApiError(500, "internal", e.what()));
-      }
-      if (!idempotency.empty() && res.status < 500 && res.content_length_ == 0 && !res.body.empty())
-        service_.remember(idempotency, res.status, res.body);
-      ++service_.requests_total;
-      if (res.status >= 400) ++service_.request_errors_total;
-      const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-      if (json_log)
-        spdlog::info(json{{"request_id", request_id}, {"method", req.method}, {"path", sanitize_utf8(req.path)},
-                          {"status", res.status}, {"ms", ms}}
-                         .dump(-1, ' ', false, json::error_handler_t::replace));
-      else
-        spdlog::info("{} {} {} {:.1f} ms [{}]", req.method, sanitize_utf8(req.path.substr(0, 200)), res.status, ms,
-                     request_id);
+    auto run = [this, &route](const httplib::Request& req, httplib::Response& res, const httplib::ContentReader* reader) {
+      handle(route, req, res, reader);
     };
     auto plain = [run](const httplib::Request& req, httplib::Response& res) { run(req, res, nullptr); };
     auto with_body = [run](const httplib::Request& req, httplib::Response& res, const httplib::ContentReader& reader) {
@@ -265,6 +181,100 @@ void HttpServer::install() {
     res.set_content(json{{"error", {{"code", code}, {"message", message}, {"details", json::object()}}}}.dump(),
                     "application/json");
   });
+}
+
+// One request: its id, CORS, the token, idempotency, the body, the handler, the JSON error,
+// the counters and one log line.
+void HttpServer::handle(const Route& route, const httplib::Request& req, httplib::Response& res,
+                        const httplib::ContentReader* reader) {
+  const auto t0 = std::chrono::steady_clock::now();
+  const std::string request_id = request_id_of(req);
+  res.set_header("X-Request-Id", request_id);
+  const service::ServiceConfig& cfg = service_.config();
+  if (!cfg.cors_origin.empty() && req.get_header_value("Origin") == cfg.cors_origin)
+    res.set_header("Access-Control-Allow-Origin", cfg.cors_origin);
+  std::string idempotency;
+  try {
+    authenticate(route, req);
+    if (route.writes && !service_.ready()) throw ApiError(503, "shutting_down", "the server is shutting down");
+    bool replayed = false;
+    if (route.method == "POST" && req.has_header("Idempotency-Key")) {
+      idempotency = req.get_header_value("Authorization") + "|" + req.path + "|" +
+                    req.get_header_value("Idempotency-Key").substr(0, 200);
+      if (auto previous = service_.replay(idempotency)) {
+        res.status = previous->first;
+        res.set_content(previous->second, "application/json");
+        res.set_header("Idempotent-Replayed", "true");
+        idempotency.clear();
+        replayed = true;
+      }
+    }
+    if (!replayed) {
+      RouteContext ctx{service_, req, res, nullptr, {}};
+      if (reader != nullptr && route.streams_body) ctx.reader = reader;
+      else if (reader != nullptr) ctx.body_text = read_body(req, *reader);
+      run_handler(route, ctx);
+    }
+  } catch (const ApiError& e) {
+    write_error(res, e);
+  } catch (const Error& e) {
+    write_error(res, ApiError::from_error(e));
+  } catch (const std::bad_alloc&) {
+    write_error(res, ApiError(507, "out_of_memory", "the server ran out of memory for this request"));
+  } catch (const std::exception& e) {
+    write_error(res, ApiError(500, "internal", e.what()));
+  }
+  if (!idempotency.empty() && res.status < 500 && res.content_length_ == 0 && !res.body.empty())
+    service_.remember(idempotency, res.status, res.body);
+  ++service_.requests_total;
+  if (res.status >= 400) ++service_.request_errors_total;
+  const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  if (cfg.log_format == "json")
+    spdlog::info(json{{"request_id", request_id}, {"method", req.method}, {"path", sanitize_utf8(req.path)},
+                      {"status", res.status}, {"ms", ms}}
+                     .dump(-1, ' ', false, json::error_handler_t::replace));
+  else
+    spdlog::info("{} {} {} {:.1f} ms [{}]", req.method, sanitize_utf8(req.path.substr(0, 200)), res.status, ms, request_id);
+}
+
+// Tokens when configured (always beyond loopback). Probes and the viewer page (static; the
+// token is typed into it) need none. Browsers cannot set headers on <img> and EventSource:
+// GET routes also take ?access_token=.
+void HttpServer::authenticate(const Route& route, const httplib::Request& req) const {
+  const bool open = route.path == "/healthz" || route.path == "/readyz" || route.path == "/";
+  if (tokens_.empty() || open) return;
+  const std::string auth = req.get_header_value("Authorization");
+  std::string given;
+  if (auth.rfind("Bearer ", 0) == 0) given = auth.substr(7);
+  else if (route.method == "GET" && req.has_param("access_token")) given = req.get_param_value("access_token");
+  const Role* role = nullptr;
+  if (!given.empty())
+    for (const auto& [token, r] : tokens_)
+      if (same_token(given, token)) role = &r;
+  if (role == nullptr) throw ApiError(401, "unauthorized", "a valid bearer token is required");
+  if (route.writes && *role == Role::ReadOnly)
+    throw ApiError(403, "forbidden", "this token is read-only; " + route.method + " needs a read-write token");
+}
+
+// A JSON body, read up to max_body_bytes (413 past it, before reading when the length says so).
+std::string HttpServer::read_body(const httplib::Request& req, const httplib::ContentReader& reader) const {
+  const std::uint64_t limit = service_.config().max_body_bytes;
+  const std::string length = req.get_header_value("Content-Length");
+  if (!length.empty() && std::strtoull(length.c_str(), nullptr, 10) > limit)
+    throw ApiError(413, "payload_too_large",
+                   "the body has " + length + " bytes, more than max_body_bytes (" + std::to_string(limit) + ")");
+  std::string body;
+  bool over = false;
+  reader([&](const char* data, std::size_t n) {
+    if (body.size() + n > limit) {
+      over = true;
+      return false;
+    }
+    body.append(data, n);
+    return true;
+  });
+  if (over) throw ApiError(413, "payload_too_large", "the body is larger than max_body_bytes (" + std::to_string(limit) + ")");
+  return body;
 }
 
 int HttpServer::bind() {

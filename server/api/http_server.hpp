@@ -36,6 +36,10 @@ class HttpServer {
 
  private:
   void install();
+  void handle(const struct Route& route, const httplib::Request& req, httplib::Response& res,
+              const httplib::ContentReader* reader);
+  void authenticate(const struct Route& route, const httplib::Request& req) const;
+  std::string read_body(const httplib::Request& req, const httplib::ContentReader& reader) const;
 
   service::Service& service_;
   std::unique_ptr<httplib::Server> server_;
