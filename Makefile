@@ -4,12 +4,19 @@ BUILD  := build/$(PRESET)
 OUT    ?= out
 JOBS   ?= $(shell nproc)
 
-.PHONY: all deps configure build run serve test bench fuzz clean
+RUN_BUILD := build/$(PRESET)-run
+
+.PHONY: all deps deps-run configure build build-run run serve test bench fuzz clean
 
 all: build
 
+# Everything: build, runtime, and what tests, fuzzing and benchmarks use.
 deps:
 	@bash deploy/install-deps.sh
+
+# What building and running levelsetd needs, nothing more (make run, make serve).
+deps-run:
+	@bash deploy/install-deps.sh build runtime
 
 configure: deps
 	@cmake --preset $(PRESET) >/dev/null
@@ -17,14 +24,20 @@ configure: deps
 build: configure
 	@cmake --build $(BUILD) -j $(JOBS)
 
+# levelsetd alone, in its own build folder without tests or benchmarks (issue 18: make run
+# built the unit tests, fuzz replays and OpenVDB benchmarks it never ran).
+build-run: deps-run
+	@cmake --preset $(PRESET) -B $(RUN_BUILD) -DLEVELSET_BUILD_TESTS=OFF -DLEVELSET_BUILD_BENCH=OFF >/dev/null
+	@cmake --build $(RUN_BUILD) --target levelsetd -j $(JOBS)
+
 # Main job on an embedded default: the surface reconstruction from 20000 points sampled on
 # the built-in torus knot (no external files); prints the progress and where the outputs went.
-run: build
-	@$(BUILD)/server/levelsetd run configs/jobs/reconstruct_knot.conf -o $(OUT)
+run: build-run
+	@$(RUN_BUILD)/server/levelsetd run configs/jobs/reconstruct_knot.conf -o $(OUT)
 
 # The daemon on its defaults (127.0.0.1:8080, data in $XDG_STATE_HOME/levelset); Ctrl-C stops it.
-serve: build
-	@$(BUILD)/server/levelsetd serve
+serve: build-run
+	@$(RUN_BUILD)/server/levelsetd serve
 
 test: build
 	@cd $(BUILD) && ctest --output-on-failure -j $(JOBS)
