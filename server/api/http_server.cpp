@@ -112,6 +112,7 @@ std::map<std::string, Role> load_tokens(const std::string& file, const std::stri
 HttpServer::HttpServer(service::Service& service) : service_(service) {
   const service::ServiceConfig& c = service.config();
   tokens_ = load_tokens(c.token_file, c.tokens);
+  routing_ = std::make_unique<ReplicaRouting>(c.replica, c.peers);
   loopback_ = is_loopback(c.host);
   if (!loopback_ && tokens_.empty() && !c.insecure_no_auth)
     throw Error(ErrorCode::InvalidArgument, "--host " + c.host,
@@ -209,8 +210,18 @@ void HttpServer::handle(const Route& route, const httplib::Request& req, httplib
         replayed = true;
       }
     }
+    // Another replica's session or job: redirected there (307 keeps the method and body).
+    if (routing_->enabled() && req.matches.size() > 1 &&
+        (route.path.find("{id}") != std::string::npos || route.path.find("{jid}") != std::string::npos)) {
+      if (auto url = routing_->redirect_for(std::string(req.matches[1]), req.target)) {
+        res.status = 307;
+        res.set_header("Location", *url);
+        res.set_content(json{{"redirect", *url}}.dump(), "application/json");
+        replayed = true;
+      }
+    }
     if (!replayed) {
-      RouteContext ctx{service_, req, res, nullptr, {}};
+      RouteContext ctx{service_, req, res, nullptr, {}, routing_.get()};
       if (reader != nullptr && route.streams_body) ctx.reader = reader;
       else if (reader != nullptr) ctx.body_text = read_body(req, *reader);
       run_handler(route, ctx);

@@ -16,6 +16,7 @@
 
 #include <httplib.h>
 
+#include "api/replica_routing.hpp"
 #include "service/service.hpp"
 
 namespace levelset::api {
@@ -44,6 +45,7 @@ class HttpServer {
   service::Service& service_;
   std::unique_ptr<httplib::Server> server_;
   std::map<std::string, Role> tokens_;
+  std::unique_ptr<ReplicaRouting> routing_;
   bool loopback_ = true;
   int listen_fd_ = -1;
 };

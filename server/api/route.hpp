@@ -15,12 +15,15 @@
 
 namespace levelset::api {
 
+class ReplicaRouting;
+
 struct RouteContext {
   service::Service& service;
   const httplib::Request& req;
   httplib::Response& res;
   const httplib::ContentReader* reader = nullptr;  // uploads: the body, streamed
   std::string body_text;                           // other POST / PATCH routes: the body, read
+  const ReplicaRouting* routing = nullptr;         // the other replicas, when configured
   std::string param(std::size_t i) const { return req.matches.size() > i ? std::string(req.matches[i]) : ""; }
   nlohmann::json body() const;  // the JSON body: ApiError 400 (malformed, with line and column) or 413
   void reply(int status, const nlohmann::json& j, const std::string& location = "") const;

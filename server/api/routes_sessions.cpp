@@ -4,6 +4,7 @@
 #include <cstdlib>
 #include <thread>
 
+#include "api/replica_routing.hpp"
 #include "api/route.hpp"
 #include "service/api_error.hpp"
 
@@ -145,8 +146,19 @@ void add_session_routes(std::vector<Route>& r) {
                  c.res.status = 204;
                }});
   // ---- sessions
-  r.push_back({"GET", "/api/v1/sessions", "List this replica's sessions", false, false, {}, nullptr,
-               {{"200", "sessions"}}, [](RouteContext& c) { c.reply(200, c.service.list_sessions()); }});
+  r.push_back({"GET", "/api/v1/sessions",
+               "List the sessions of every replica (with peers configured; ?local=1: this replica's only)", false,
+               false, {"local"}, nullptr, {{"200", "sessions"}}, [](RouteContext& c) {
+                 json list = c.service.list_sessions();
+                 if (c.routing != nullptr && c.routing->enabled() && !c.req.has_param("local")) {
+                   for (json& s : list["sessions"]) s["replica"] = c.service.config().replica;
+                   json unreachable;
+                   for (json& s : c.routing->peer_sessions(c.req.get_header_value("Authorization"), unreachable))
+                     list["sessions"].push_back(std::move(s));
+                   list["unreachable"] = unreachable;
+                 }
+                 c.reply(200, list);
+               }});
   r.push_back({"POST", "/api/v1/sessions",
                "Create a session: {\"primitive\": NAME, \"raster\": {...}} or {\"upload\": ID, ...op parameters}", true,
                false, {}, kJson, {{"201", "the session (primitive, band upload)"}, {"202", "a job creates it"}},

@@ -111,6 +111,10 @@ const std::vector<ServiceOption>& service_options() {
          c.render = v;
        },
        [](const ServiceConfig& c) { return c.render; }},
+      text("peers",
+           "The other replicas as REPLICA=URL,...: requests for their sessions and jobs are redirected there, and "
+           "GET /api/v1/sessions lists theirs too",
+           &ServiceConfig::peers),
       integer("max_jobs", "Jobs running at once (0: one per two cores)", &ServiceConfig::max_jobs, 0, 1024),
       integer("max_queued_jobs", "Jobs waiting; beyond it 429", &ServiceConfig::max_queued_jobs, 0, 100000),
       integer("max_sessions", "Sessions held; beyond it 507", &ServiceConfig::max_sessions, 1, 1000000),

@@ -26,6 +26,7 @@ struct ServiceConfig {
   std::string log_format = "text";  // text | json
   std::string replica;              // prefix of every id (a StatefulSet pod name); default: host name
   std::string render = "egl";       // egl | osmesa | off: the offscreen GL context for frames
+  std::string peers;                // "replica=URL,...": the other replicas (session-affine routing)
   // Limits (0 = sized from the machine at start: see finalize()).
   int max_jobs = 0;                 // jobs running at once (default: one per two cores)
   int max_queued_jobs = 64;

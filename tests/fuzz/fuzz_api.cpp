@@ -85,7 +85,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
       [&](httplib::ContentReceiver receiver) { return receiver(body.data(), body.size()); },
       [&](httplib::MultipartContentHeader, httplib::ContentReceiver) { return false; });
   req.set_header("Content-Length", std::to_string(body.size()));
-  levelset::api::RouteContext ctx{*w.service, req, res, route.streams_body ? &reader : nullptr, body};
+  levelset::api::RouteContext ctx{*w.service, req, res, route.streams_body ? &reader : nullptr, body, nullptr};
   try {
     levelset::api::run_handler(route, ctx);
   } catch (const levelset::service::ApiError&) {

@@ -530,6 +530,48 @@ def test_preview_while_running():
         d.stop()
 
 
+def test_two_replicas():
+    """Session-affine routing: two daemons named as a StatefulSet would name them, each with the
+    other as a peer; a session created on one is reached through the other (307), and either
+    lists both replicas' sessions."""
+    import socket
+    ports = []
+    for _ in range(2):
+        with socket.socket() as sock:
+            sock.bind(("127.0.0.1", 0))
+            ports.append(sock.getsockname()[1])
+    a = Daemon(BIN, fresh("replica-a"), "--replica", "levelsetd-0", "--peers",
+               f"levelsetd-1=http://127.0.0.1:{ports[1]}", port=ports[0])
+    b = Daemon(BIN, fresh("replica-b"), "--replica", "levelsetd-1", "--peers",
+               f"levelsetd-0=http://127.0.0.1:{ports[0]}", port=ports[1])
+    try:
+        sa = sphere_session(a, 16, "on-a")
+        sb = sphere_session(b, 16, "on-b")
+        check(sa["id"].startswith("levelsetd-0-s-") and sb["id"].startswith("levelsetd-1-s-"), "ids carry the replica")
+        # urllib follows the 307: the session on A read through B.
+        status, _, via_b = b.get(f"/api/v1/sessions/{sa['id']}")
+        check(status == 200 and via_b["name"] == "on-a", f"A's session through B: {status} {via_b}")
+        # A POST is answered 307 with the owner's URL (urllib does not re-send a POST; curl -L does).
+        status, hdrs, body = b.post(f"/api/v1/sessions/{sa['id']}/jobs", {"op": "measure"})
+        check(status == 307 and hdrs["Location"] == f"{a.url}/api/v1/sessions/{sa['id']}/jobs", f"POST via B: {status} {hdrs}")
+        status, _, job = a.post(hdrs["Location"][len(a.url):], {"op": "measure"})
+        check(status == 202 and job["id"].startswith("levelsetd-0-j-"), f"a job on A's session: {status} {job}")
+        curl = subprocess.run(["curl", "-s", "-L", "-X", "POST", "-d", '{"op": "measure"}',
+                               f"{b.url}/api/v1/sessions/{sa['id']}/jobs"], capture_output=True, text=True)
+        check(json.loads(curl.stdout).get("state") in ("queued", "running", "succeeded") or "session_busy" in curl.stdout,
+              f"curl -L follows the redirect with its body: {curl.stdout[:200]}")
+        check(b.wait_job(job["id"])["state"] == "succeeded", "the job ran on A, followed through B")
+        for d, name in ((a, "A"), (b, "B")):
+            listed = d.get("/api/v1/sessions")[2]
+            names = sorted(s["name"] for s in listed["sessions"])
+            check(names == ["on-a", "on-b"] and listed["unreachable"] == [], f"{name} lists both: {listed}")
+            local = d.get("/api/v1/sessions?local=1")[2]
+            check(len(local["sessions"]) == 1, f"{name} ?local=1 lists its own only")
+    finally:
+        a.stop()
+        b.stop()
+
+
 def test_concurrency():
     """64 clients creating sessions, submitting jobs, polling and holding event streams."""
     d = Daemon(BIN, fresh("concurrency"), "--max-queued-jobs", "256")

@@ -17,14 +17,14 @@ import urllib.request
 
 
 class Daemon:
-    def __init__(self, binary, data_dir, *flags, env=None, preexec_fn=None, start_timeout=20):
+    def __init__(self, binary, data_dir, *flags, env=None, preexec_fn=None, start_timeout=20, port=0):
         self.binary, self.data_dir, self.flags = binary, data_dir, list(flags)
         self.log_path = os.path.join(data_dir + ".log")
         os.makedirs(os.path.dirname(os.path.abspath(data_dir)), exist_ok=True)
         self.log = open(self.log_path, "ab")
         full_env = dict(os.environ)
         full_env.update(env or {})
-        self.proc = subprocess.Popen([binary, "serve", "--port", "0", "--data", data_dir, *self.flags],
+        self.proc = subprocess.Popen([binary, "serve", "--port", str(port), "--data", data_dir, *self.flags],
                                      stdout=subprocess.PIPE, stderr=self.log, env=full_env, preexec_fn=preexec_fn)
         line = self._read_ready_line(start_timeout)
         m = re.match(r"levelsetd listening on (https?)://([^:]+):(\d+)", line)

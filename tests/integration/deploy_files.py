@@ -66,6 +66,10 @@ limit = size_bytes(c["resources"]["limits"]["memory"])
 check(limit is not None and limit > size_bytes(env["LEVELSET_MAX_BAND_MEMORY"]["value"]),
       "the memory limit leaves room above the band budget")
 check(pod["securityContext"]["runAsNonRoot"] is True, "non-root")
+peers = dict(item.split("=", 1) for item in env["LEVELSET_PEERS"]["value"].split(","))
+check(sorted(peers) == [f"{sts['metadata']['name']}-{i}" for i in range(sts["spec"]["replicas"])] and
+      all(f".{sts['spec']['serviceName']}:" in url for url in peers.values()),
+      f"the peer list names every replica through the headless Service: {peers}")
 
 # ---- Dockerfile: the final stage's packages are install-deps.sh's runtime group, nothing else
 docker = open(os.path.join(DEPLOY, "Dockerfile")).read()
