@@ -7,6 +7,7 @@
 // each input, so background work stays bounded; the limits are small (a 64^3-ish box).
 #include <cstddef>
 #include <cstdint>
+#include <cstdlib>
 #include <filesystem>
 #include <regex>
 #include <string>
@@ -41,6 +42,9 @@ World& world() {
     c.replica = "fuzz";
     levelset::service::finalize(c);
     x.service = std::make_unique<Service>(c);
+    // The data directory goes when the process ends (one per run of the target).
+    static const std::string data_dir = c.data_dir;
+    std::atexit([] { std::filesystem::remove_all(data_dir); });
     x.session = x.service->create_session({{"primitive", "sphere"}, {"raster", {{"resolution", 16}}}}).body["id"];
     x.job = x.service->submit(x.session, {{"op", "measure"}}).body["id"];
     return x;
