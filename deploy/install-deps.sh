@@ -41,7 +41,7 @@ TEST_PACKAGES=(
   libcgal-demo
   # scripts of the integration tests and benchmarks (/usr/bin/python3), the README's curl + jq
   # walk-through, a self-signed certificate for the TLS test
-  python3 python3-yaml curl jq openssl
+  python3 python3-yaml python3-pil curl jq openssl
   # deployment file checks: systemd-analyze verify of the unit
   systemd
   # daemon benchmark (bench_server): HTTP load generator

@@ -61,6 +61,7 @@ void stream_frames(RouteContext& c) {
   struct Cursor {
     std::uint64_t state = ~std::uint64_t{0};
     std::chrono::steady_clock::time_point last{};
+    std::shared_ptr<const std::string> frame;  // the last part sent
   };
   auto cursor = std::make_shared<Cursor>();
   ++svc.streams_open;
@@ -85,16 +86,31 @@ void stream_frames(RouteContext& c) {
             } catch (const std::exception&) {
               return false;  // the session went away or the renderer stopped: end the stream
             }
-            const std::string head = "--levelsetframe\r\nContent-Type: image/jpeg\r\nContent-Length: " +
-                                     std::to_string(f.bytes->size()) + "\r\n\r\n";
+            // Each part ends with the next boundary, so a browser shows it at once instead of
+            // waiting for the following frame (which may not come until something changes).
+            const std::string head = std::string(cursor->state == ~std::uint64_t{0} ? "--levelsetframe\r\n" : "") +
+                                     "Content-Type: image/jpeg\r\nContent-Length: " + std::to_string(f.bytes->size()) +
+                                     "\r\n\r\n";
+            static const std::string tail = "\r\n--levelsetframe\r\n";
             if (!sink.write(head.data(), head.size()) || !sink.write(f.bytes->data(), f.bytes->size()) ||
-                !sink.write("\r\n", 2))
+                !sink.write(tail.data(), tail.size()))
               return false;
             cursor->state = drawn;
             cursor->last = std::chrono::steady_clock::now();
+            cursor->frame = f.bytes;
             return true;
           }
           session->events().wait_after(session->events().last_id(), std::chrono::milliseconds(100));
+        }
+        // Nothing changed for a second: the last frame again. Browsers show a part only once the
+        // following one starts, and a dead client is noticed here.
+        if (cursor->frame) {
+          const std::string head =
+              "Content-Type: image/jpeg\r\nContent-Length: " + std::to_string(cursor->frame->size()) + "\r\n\r\n";
+          static const std::string again_tail = "\r\n--levelsetframe\r\n";
+          if (!sink.write(head.data(), head.size()) || !sink.write(cursor->frame->data(), cursor->frame->size()) ||
+              !sink.write(again_tail.data(), again_tail.size()))
+            return false;
         }
         return true;
       },

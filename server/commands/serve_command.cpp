@@ -72,6 +72,7 @@ int serve(ServeArgs& a) {
   api::HttpServer http(service);
   const int port = http.bind();
   spdlog::info("data {} ; {} sessions ; {} job workers", config.data_dir, service.sessions().count(), config.max_jobs);
+  spdlog::info("render: {}", service.render_status());
   std::printf("levelsetd listening on http%s://%s:%d\n", config.tls_cert.empty() ? "" : "s", config.host.c_str(), port);
   std::fflush(stdout);
 

@@ -572,6 +572,93 @@ def test_two_replicas():
         b.stop()
 
 
+def decode(image_bytes):
+    import io
+    from PIL import Image
+    return Image.open(io.BytesIO(image_bytes)).convert("RGB")
+
+
+def foreground(img, background=(0.13, 0.13, 0.2)):
+    bg = tuple(round(c * 255) for c in background)
+    return sum(1 for p in img.getdata() if max(abs(p[i] - bg[i]) for i in range(3)) > 12)
+
+
+def test_frames():
+    """Frames of known scenes through EGL and OSMesa: the sphere's silhouette against the
+    camera's projection, the shading modes, EGL and OSMesa agreeing, size limits, the stream."""
+    import math
+    d = Daemon(BIN, fresh("frames-egl"), "--render", "egl")
+    o = Daemon(BIN, fresh("frames-osmesa"), "--render", "osmesa")
+    try:
+        check("render: egl:" in d.read_log() and "render: osmesa:" in o.read_log(), "one log line names the renderer")
+        w, h = 320, 240
+        images = {}
+        for name, daemon in (("egl", d), ("osmesa", o)):
+            s = sphere_session(daemon, 64)
+            status, hdrs, png = daemon.request("GET", f"/api/v1/sessions/{s['id']}/frame?width={w}&height={h}&format=png")
+            check(status == 200 and hdrs["Content-Type"] == "image/png", f"{name} frame: {status} {hdrs}")
+            img = decode(png)
+            check(img.size == (w, h), f"{name}: size {img.size}")
+            images[name] = img
+            # The camera fits the sphere's box: its bounding sphere (radius sqrt(3)) fills the
+            # 40 degree field of view; the unit sphere's silhouette has this radius in pixels.
+            distance = math.sqrt(3) / math.sin(math.radians(20))
+            rho = (h / 2) * math.tan(math.asin(1 / distance)) / math.tan(math.radians(20))
+            area = foreground(img)
+            check(abs(area - math.pi * rho * rho) < 0.04 * math.pi * rho * rho,
+                  f"{name}: silhouette {area} px, expected {math.pi * rho * rho:.0f}")
+            # Headlight: the centre is brighter than a point near the rim.
+            centre = sum(img.getpixel((w // 2, h // 2)))
+            rim = sum(img.getpixel((int(w / 2 + 0.9 * rho), h // 2)))
+            check(centre > rim, f"{name}: lit centre {centre} vs rim {rim}")
+            counts, shades = {}, {}
+            for shading in ("none", "points", "wireframe", "flat", "smooth"):
+                _, _, frame = daemon.request("GET", f"/api/v1/sessions/{s['id']}/frame?width={w}&height={h}&shading={shading}&format=png")
+                img_s = decode(frame)
+                counts[shading] = foreground(img_s)
+                shades[shading] = len(set(img_s.getdata()))
+            # none draws nothing; points and wireframe are unlit (a few colours, the background and
+            # the edges' blends); flat and smooth cover the silhouette with many shades.
+            check(counts["none"] == 0, f"{name}: none draws nothing")
+            check(all(counts[m] > 0.5 * area for m in ("points", "wireframe", "flat", "smooth")), f"{name}: coverage {counts}")
+            check(abs(counts["flat"] - counts["smooth"]) < 0.02 * counts["smooth"], f"{name}: flat vs smooth {counts}")
+            check(shades["points"] <= 3 and shades["wireframe"] <= 3 and shades["flat"] > 50 and shades["smooth"] > 50,
+                  f"{name}: shades per mode {shades}")
+            status, _, body = daemon.get(f"/api/v1/sessions/{s['id']}/frame?width=5000&height=100")
+            check(status == 422, f"{name}: a 5000-pixel frame: {status}")
+            status, _, body = daemon.get(f"/api/v1/sessions/{s['id']}/frame?shading=glossy")
+            check(status == 422 and "shading" in body["error"]["message"], f"{name}: a bad setting: {status} {body}")
+        diff = sum(abs(a - b) for pa, pb in zip(images["egl"].getdata(), images["osmesa"].getdata()) for a, b in zip(pa, pb))
+        check(diff / (w * h * 3) < 2.0, f"EGL and OSMesa differ by {diff / (w * h * 3):.2f} levels on average")
+        # The MJPEG stream: new frames while a job moves the surface.
+        s = sphere_session(d, 48)
+        job = long_evolve(d, s["id"], steps=100000, speed="-(k1+k2)*0.02")
+        import urllib.request
+        frames = []
+        with urllib.request.urlopen(f"{d.url}/api/v1/sessions/{s['id']}/stream?width=160&height=120", timeout=60) as r:
+            check(r.headers["Content-Type"].startswith("multipart/x-mixed-replace"), f"stream type: {r.headers['Content-Type']}")
+            while len(frames) < 4:
+                line = r.readline()
+                if line.lower().startswith(b"content-length:"):
+                    n = int(line.split(b":")[1])
+                    r.readline()
+                    frames.append(r.read(n))
+        d.json_request("DELETE", f"/api/v1/jobs/{job['id']}")
+        check(all(decode(f).size == (160, 120) for f in frames), "stream frames decode at the requested size")
+        check(len(set(frames)) >= 3, f"the stream's frames change while the job runs: {len(set(frames))} distinct")
+    finally:
+        d.stop()
+        o.stop()
+    off = Daemon(BIN, fresh("frames-off"), "--render", "off")
+    try:
+        s = sphere_session(off, 16)
+        status, _, body = off.get(f"/api/v1/sessions/{s['id']}/frame")
+        check(status == 503 and body["error"]["code"] == "rendering_off", f"--render off: {status} {body}")
+        check(off.get(f"/api/v1/sessions/{s['id']}/mesh?format=off")[0] == 200, "everything else works with --render off")
+    finally:
+        off.stop()
+
+
 def test_concurrency():
     """64 clients creating sessions, submitting jobs, polling and holding event streams."""
     d = Daemon(BIN, fresh("concurrency"), "--max-queued-jobs", "256")
