@@ -83,9 +83,14 @@ runtime = subprocess.run(["bash", os.path.join(DEPLOY, "install-deps.sh"), "list
                          check=True).stdout.split()
 check(len(runtime) >= 10 and "libosmesa6" in runtime and "libcpp-httplib0.11" in runtime,
       f"the runtime group lists what levelsetd loads: {runtime}")
-# Every shared library levelsetd loads comes from a package of the runtime group (or libc's).
+# Every library levelsetd links directly (its NEEDED entries) comes from a package of the
+# runtime group (or libc's); apt brings what those packages depend on.
 ldd = subprocess.run(["ldd", BIN], capture_output=True, text=True).stdout
-for lib in re.findall(r"=> (/\S+)", ldd):
+where = dict(re.findall(r"^\s*(\S+) => (/\S+)", ldd, re.M))
+needed = re.findall(r"\(NEEDED\)\s+Shared library: \[(.+?)\]", subprocess.run(["readelf", "-d", BIN],
+                                                                              capture_output=True, text=True).stdout)
+check(len(needed) >= 8, f"readelf found the NEEDED libraries: {needed}")
+for lib in (where.get(name, name) for name in needed):
     # With merged /usr, dpkg may list the file under /lib or under /usr/lib.
     owner = ""
     for candidate in (lib, "/usr" + lib if not lib.startswith("/usr") else lib[4:], os.path.realpath(lib)):
