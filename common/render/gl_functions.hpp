@@ -2,8 +2,11 @@
 // proc-address function (eglGetProcAddress or OSMesaGetProcAddress). Every gl* call goes
 // through this table: libOSMesa and libOpenGL both export gl* symbols, so calling them directly
 // would bind to whichever the linker met first (../shared/notes/stack.md).
-// Errors: Error{Unsupported...} naming the first missing function. Threading: the table is
-// plain data; use it on the thread where its context is current.
+// Only the functions levelset_render uses are listed (LEVELSET_GL_FUNCTIONS); a window context
+// (GLFW in the desktop client) loads the same table from glfwGetProcAddress.
+// Errors: Error{UnsupportedFormat, "OpenGL", "the context has no glX"} naming the first missing
+// function. Cost: ~70 look-ups once per context. Threading: the table is plain data; use it on
+// the thread where its context is current.
 #pragma once
 
 #include <GL/glcorearb.h>
@@ -40,7 +43,12 @@ struct GlFunctions {
   X(PFNGLBINDBUFFERPROC, BindBuffer) X(PFNGLBUFFERDATAPROC, BufferData)                              \
   X(PFNGLDELETEBUFFERSPROC, DeleteBuffers) X(PFNGLVERTEXATTRIBPOINTERPROC, VertexAttribPointer)      \
   X(PFNGLENABLEVERTEXATTRIBARRAYPROC, EnableVertexAttribArray) X(PFNGLDRAWARRAYSPROC, DrawArrays)    \
-  X(PFNGLDRAWELEMENTSPROC, DrawElements)
+  X(PFNGLDRAWELEMENTSPROC, DrawElements) X(PFNGLUNIFORM4FPROC, Uniform4f) X(PFNGLBLENDFUNCPROC, BlendFunc)   \
+  X(PFNGLDEPTHMASKPROC, DepthMask) X(PFNGLGENTEXTURESPROC, GenTextures)                              \
+  X(PFNGLBINDTEXTUREPROC, BindTexture) X(PFNGLDELETETEXTURESPROC, DeleteTextures)                    \
+  X(PFNGLTEXPARAMETERIPROC, TexParameteri) X(PFNGLTEXIMAGE3DPROC, TexImage3D)                        \
+  X(PFNGLACTIVETEXTUREPROC, ActiveTexture) X(PFNGLVERTEXATTRIB1FPROC, VertexAttrib1f)               \
+  X(PFNGLDISABLEVERTEXATTRIBARRAYPROC, DisableVertexAttribArray)
 #define LEVELSET_GL_MEMBER(type, name) type name = nullptr;
   LEVELSET_GL_FUNCTIONS(LEVELSET_GL_MEMBER)
 #undef LEVELSET_GL_MEMBER

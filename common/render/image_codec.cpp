@@ -3,6 +3,8 @@
 #include <png.h>
 #include <turbojpeg.h>
 
+#include <string>
+
 #include "core/error.hpp"
 
 namespace levelset::render {
@@ -16,6 +18,8 @@ void check_image(const Image& image) {
 
 std::string encode_jpeg(const Image& image, int quality) {
   check_image(image);
+  if (quality < 1 || quality > 100)
+    throw Error(ErrorCode::InvalidArgument, "jpeg quality", "expected 1 to 100, found " + std::to_string(quality));
   tjhandle tj = tjInitCompress();
   if (tj == nullptr) throw Error(ErrorCode::IoError, "jpeg", "cannot start the encoder");
   unsigned char* out = nullptr;
@@ -54,6 +58,37 @@ std::string encode_png(const Image& image) {
   png_write_end(png, nullptr);
   png_destroy_write_struct(&png, &info);
   return bytes;
+}
+
+Image decode_jpeg(std::string_view bytes) {
+  tjhandle tj = tjInitDecompress();
+  if (tj == nullptr) throw Error(ErrorCode::IoError, "jpeg", "cannot start the decoder");
+  Image image;
+  int subsampling = 0, colorspace = 0;
+  const auto* data = reinterpret_cast<const unsigned char*>(bytes.data());
+  bool ok = tjDecompressHeader3(tj, data, bytes.size(), &image.width, &image.height, &subsampling, &colorspace) == 0 &&
+            image.width > 0 && image.height > 0;
+  if (ok) {
+    image.rgb.resize(std::size_t(image.width) * image.height * 3);
+    ok = tjDecompress2(tj, data, bytes.size(), image.rgb.data(), image.width, 0, image.height, TJPF_RGB, 0) == 0;
+  }
+  tjDestroy(tj);
+  if (!ok) throw Error(ErrorCode::ParseError, "jpeg", "the bytes do not decode as JPEG");
+  return image;
+}
+
+Image decode_png(std::string_view bytes) {
+  png_image png{};
+  png.version = PNG_IMAGE_VERSION;
+  if (!png_image_begin_read_from_memory(&png, bytes.data(), bytes.size()))
+    throw Error(ErrorCode::ParseError, "png", "the bytes do not decode as PNG");
+  png.format = PNG_FORMAT_RGB;
+  Image image{int(png.width), int(png.height), std::vector<unsigned char>(PNG_IMAGE_SIZE(png))};
+  if (!png_image_finish_read(&png, nullptr, image.rgb.data(), 0, nullptr)) {
+    png_image_free(&png);
+    throw Error(ErrorCode::ParseError, "png", "the bytes do not decode as PNG");
+  }
+  return image;
 }
 
 }  // namespace levelset::render

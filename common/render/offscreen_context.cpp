@@ -5,6 +5,7 @@
 #include <GL/osmesa.h>
 
 #include <cstring>
+#include <vector>
 
 #include "core/error.hpp"
 
@@ -14,11 +15,51 @@ namespace {
 
 [[noreturn]] void fail(const std::string& where, const std::string& why) { throw Error(ErrorCode::IoError, where, why); }
 
+// The first EGL device backed by hardware (a DRM device), or EGL_NO_DEVICE_EXT.
+EGLDeviceEXT hardware_device() {
+  auto query_devices = reinterpret_cast<PFNEGLQUERYDEVICESEXTPROC>(eglGetProcAddress("eglQueryDevicesEXT"));
+  auto query_string = reinterpret_cast<PFNEGLQUERYDEVICESTRINGEXTPROC>(eglGetProcAddress("eglQueryDeviceStringEXT"));
+  if (query_devices == nullptr || query_string == nullptr) return EGL_NO_DEVICE_EXT;
+  EGLint count = 0;
+  if (!query_devices(0, nullptr, &count) || count <= 0) return EGL_NO_DEVICE_EXT;
+  std::vector<EGLDeviceEXT> devices(static_cast<std::size_t>(count));
+  if (!query_devices(count, devices.data(), &count)) return EGL_NO_DEVICE_EXT;
+  for (EGLint i = 0; i < count; ++i) {
+    const char* extensions = query_string(devices[std::size_t(i)], EGL_EXTENSIONS);
+    if (extensions != nullptr && std::strstr(extensions, "EGL_EXT_device_drm") != nullptr &&
+        std::strstr(extensions, "EGL_MESA_device_software") == nullptr)
+      return devices[std::size_t(i)];
+  }
+  return EGL_NO_DEVICE_EXT;
+}
+
 class EglContext : public OffscreenContext {
  public:
   EglContext() {
-    display_ = eglGetPlatformDisplay(EGL_PLATFORM_SURFACELESS_MESA, EGL_DEFAULT_DISPLAY, nullptr);
-    if (display_ == EGL_NO_DISPLAY) fail("eglGetPlatformDisplay", "no surfaceless EGL display");
+    if (EGLDeviceEXT device = hardware_device(); device != EGL_NO_DEVICE_EXT) {
+      try {
+        open(eglGetPlatformDisplay(EGL_PLATFORM_DEVICE_EXT, device, nullptr));
+        platform_ = "egl device";
+      } catch (const Error&) {
+        close();
+      }
+    }
+    if (context_ == EGL_NO_CONTEXT) {
+      open(eglGetPlatformDisplay(EGL_PLATFORM_SURFACELESS_MESA, EGL_DEFAULT_DISPLAY, nullptr));
+      platform_ = "egl surfaceless";
+    }
+    gl_ = load_gl_functions([](const char* name) { return reinterpret_cast<void*>(eglGetProcAddress(name)); });
+  }
+  ~EglContext() override { close(); }
+  void make_current() override {
+    if (!eglMakeCurrent(display_, EGL_NO_SURFACE, EGL_NO_SURFACE, context_)) fail("eglMakeCurrent", "cannot make it current");
+  }
+  std::string platform() const override { return platform_; }
+
+ private:
+  void open(EGLDisplay display) {
+    display_ = display;
+    if (display_ == EGL_NO_DISPLAY) fail("eglGetPlatformDisplay", "no EGL display");
     EGLint major = 0, minor = 0;
     if (!eglInitialize(display_, &major, &minor)) fail("eglInitialize", "cannot initialise EGL");
     if (!eglBindAPI(EGL_OPENGL_API)) fail("eglBindAPI", "no desktop OpenGL through EGL");
@@ -30,18 +71,20 @@ class EglContext : public OffscreenContext {
                                       EGL_CONTEXT_OPENGL_PROFILE_MASK, EGL_CONTEXT_OPENGL_CORE_PROFILE_BIT, EGL_NONE};
     context_ = eglCreateContext(display_, count > 0 ? config : EGL_NO_CONFIG_KHR, EGL_NO_CONTEXT, context_attribs);
     if (context_ == EGL_NO_CONTEXT) fail("eglCreateContext", "no OpenGL 3.3 core context");
-    if (!eglMakeCurrent(display_, EGL_NO_SURFACE, EGL_NO_SURFACE, context_)) fail("eglMakeCurrent", "cannot make it current");
-    gl_ = load_gl_functions([](const char* name) { return reinterpret_cast<void*>(eglGetProcAddress(name)); });
+    make_current();
   }
-  ~EglContext() override {
+  void close() {
+    if (display_ == EGL_NO_DISPLAY) return;
     eglMakeCurrent(display_, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
-    eglDestroyContext(display_, context_);
+    if (context_ != EGL_NO_CONTEXT) eglDestroyContext(display_, context_);
     eglTerminate(display_);
+    display_ = EGL_NO_DISPLAY;
+    context_ = EGL_NO_CONTEXT;
   }
 
- private:
   EGLDisplay display_ = EGL_NO_DISPLAY;
   EGLContext context_ = EGL_NO_CONTEXT;
+  std::string platform_;
 };
 
 class OsMesaContext : public OffscreenContext {
@@ -51,11 +94,15 @@ class OsMesaContext : public OffscreenContext {
                            OSMESA_CONTEXT_MAJOR_VERSION, 3, OSMESA_CONTEXT_MINOR_VERSION, 3, 0};
     context_ = OSMesaCreateContextAttribs(attribs, nullptr);
     if (context_ == nullptr) fail("OSMesaCreateContextAttribs", "no OpenGL 3.3 core context");
-    // OSMesa needs a buffer to be current; drawing goes to our framebuffer object.
-    if (!OSMesaMakeCurrent(context_, buffer_, GL_UNSIGNED_BYTE, 1, 1)) fail("OSMesaMakeCurrent", "cannot make it current");
+    make_current();
     gl_ = load_gl_functions([](const char* name) { return reinterpret_cast<void*>(OSMesaGetProcAddress(name)); });
   }
   ~OsMesaContext() override { OSMesaDestroyContext(context_); }
+  // OSMesa needs a buffer to be current; drawing goes to a framebuffer object.
+  void make_current() override {
+    if (!OSMesaMakeCurrent(context_, buffer_, GL_UNSIGNED_BYTE, 1, 1)) fail("OSMesaMakeCurrent", "cannot make it current");
+  }
+  std::string platform() const override { return "osmesa"; }
 
  private:
   OSMesaContext context_ = nullptr;
@@ -70,38 +117,6 @@ std::string OffscreenContext::renderer_name() const {
     return s ? std::string(reinterpret_cast<const char*>(s)) : std::string("?");
   };
   return text(GL_RENDERER) + " (" + text(GL_VERSION) + ")";
-}
-
-void OffscreenContext::bind_framebuffer(int width, int height) {
-  if (fbo_ == 0) {
-    gl_.GenFramebuffers(1, &fbo_);
-    gl_.GenRenderbuffers(1, &color_);
-    gl_.GenRenderbuffers(1, &depth_);
-  }
-  gl_.BindFramebuffer(GL_FRAMEBUFFER, fbo_);
-  if (width != width_ || height != height_) {
-    gl_.BindRenderbuffer(GL_RENDERBUFFER, color_);
-    gl_.RenderbufferStorage(GL_RENDERBUFFER, GL_RGBA8, width, height);
-    gl_.BindRenderbuffer(GL_RENDERBUFFER, depth_);
-    gl_.RenderbufferStorage(GL_RENDERBUFFER, GL_DEPTH_COMPONENT24, width, height);
-    gl_.FramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER, color_);
-    gl_.FramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, depth_);
-    if (gl_.CheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE)
-      fail("framebuffer", "incomplete at " + std::to_string(width) + "x" + std::to_string(height));
-    width_ = width;
-    height_ = height;
-  }
-  gl_.Viewport(0, 0, width, height);
-}
-
-std::vector<unsigned char> OffscreenContext::read_rgb(int width, int height) const {
-  std::vector<unsigned char> flipped(std::size_t(width) * height * 3), rows(flipped.size());
-  gl_.PixelStorei(GL_PACK_ALIGNMENT, 1);
-  gl_.ReadPixels(0, 0, width, height, GL_RGB, GL_UNSIGNED_BYTE, rows.data());
-  const std::size_t stride = std::size_t(width) * 3;
-  for (int y = 0; y < height; ++y)
-    std::memcpy(flipped.data() + std::size_t(y) * stride, rows.data() + std::size_t(height - 1 - y) * stride, stride);
-  return flipped;
 }
 
 std::unique_ptr<OffscreenContext> create_offscreen_context(ContextKind kind) {

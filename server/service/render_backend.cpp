@@ -12,18 +12,21 @@ namespace {
 class GlSceneRenderer : public SceneRenderer {
  public:
   explicit GlSceneRenderer(render::ContextKind kind)
-      : context_(render::create_offscreen_context(kind)), scene_(*context_) {}
+      : context_(render::create_offscreen_context(kind)), scene_(context_->gl()) {}
 
   std::string name() const override { return context_->renderer_name(); }
 
-  void set_scene(std::shared_ptr<const NarrowBand>, const TriangleMesh& surface) override { scene_.set_mesh(surface); }
+  void set_scene(std::shared_ptr<const NarrowBand> band, const TriangleMesh& surface) override {
+    scene_.set_scene(render::SceneData{surface, {}, std::move(band)});
+  }
 
   EncodedFrame render(const nlohmann::json& view, const std::vector<std::pair<std::string, std::string>>& query, int width,
                       int height, const std::string& format, int quality) override {
-    render::ViewSettings settings;
-    render::apply_json(settings, view);
+    render::ViewSettings settings = render::from_json(view);
     for (const auto& [key, value] : query) render::apply_query(settings, key, value);
-    const render::Image image = scene_.render(settings, width, height);
+    settings.width = width;
+    settings.height = height;
+    const render::Image image = scene_.render(settings);
     EncodedFrame f;
     f.bytes = std::make_shared<const std::string>(format == "png" ? render::encode_png(image)
                                                                   : render::encode_jpeg(image, quality));
