@@ -66,10 +66,11 @@ uniform float range_max;
 out float marker_value;
 out float keep;
 void main() {
-  gl_Position = mvp * vec4(position, 1.0);
+  keep = value >= range_min && value <= range_max ? 1.0 : 0.0;
+  // Out of range: beyond the far plane, clipped before rasterization.
+  gl_Position = keep > 0.5 ? mvp * vec4(position, 1.0) : vec4(0.0, 0.0, 2.0, 1.0);
   gl_PointSize = point_size;
   marker_value = value;
-  keep = value >= range_min && value <= range_max ? 1.0 : 0.0;
 })";
 
 const char* kMarkersFragment = R"(
