@@ -43,6 +43,8 @@ class GlSceneRenderer : public SceneRenderer {
 
 }  // namespace
 
+void check_view_settings(const nlohmann::json& view) { (void)render::from_json(view); }
+
 RendererFactory default_renderer_factory() {
   return [](const std::string& mode) -> std::unique_ptr<SceneRenderer> {
     return std::make_unique<GlSceneRenderer>(mode == "osmesa" ? render::ContextKind::OsMesa : render::ContextKind::Egl);

@@ -5,4 +5,6 @@ namespace levelset::service {
 
 RendererFactory default_renderer_factory() { return {}; }
 
+void check_view_settings(const nlohmann::json&) {}
+
 }  // namespace levelset::service

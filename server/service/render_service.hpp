@@ -89,5 +89,8 @@ class RenderService {
 
 // The renderer levelset_render provides (render_backend.cpp), or null when the build has none.
 RendererFactory default_renderer_factory();
+// Checks a session's view settings as the renderer will read them (levelset::Error naming the
+// field); no-op in builds without a renderer. Any thread (no GL).
+void check_view_settings(const nlohmann::json& view);
 
 }  // namespace levelset::service

@@ -7,6 +7,7 @@
 #include "grid/lsg_file.hpp"
 #include "service/api_error.hpp"
 #include "service/ids.hpp"
+#include "service/render_service.hpp"
 
 namespace levelset::service {
 
@@ -294,6 +295,7 @@ json SessionStore::update_view(Session& s, const json& changes) {
     json merged = s.meta_.value("view", json::object());
     merged.merge_patch(changes);
     if (merged.dump().size() > 16384) throw unprocessable("body", "the view settings are larger than 16 KiB");
+    check_view_settings(merged);  // refused here (422 naming the field), never later per frame
     s.meta_["view"] = merged;
     write_meta(s);
     view = merged;

@@ -628,6 +628,16 @@ def test_frames():
             check(status == 422, f"{name}: a 5000-pixel frame: {status}")
             status, _, body = daemon.get(f"/api/v1/sessions/{s['id']}/frame?shading=glossy")
             check(status == 422 and "shading" in body["error"]["message"], f"{name}: a bad setting: {status} {body}")
+        # The overlays through HTTP, and view settings checked when they are stored.
+        s = sphere_session(d, 48)
+        for overlay in ("slice=z", "volume=on", "field=on", "vectors=on", "curvature=on", "boundary=on"):
+            status, hdrs, png = d.request("GET", f"/api/v1/sessions/{s['id']}/frame?width=160&height=120&format=png&{overlay}")
+            check(status == 200 and decode(png).size == (160, 120), f"overlay {overlay}: {status} {png[:200]!r}")
+        status, _, body = d.json_request("PUT", f"/api/v1/sessions/{s['id']}/view", {"bogus": 1})
+        check(status == 422 and "bogus" in json.dumps(body) or "unknown view setting" in json.dumps(body),
+              f"an unknown view setting is refused when stored: {status} {body}")
+        check(d.request("GET", f"/api/v1/sessions/{s['id']}/frame?width=64&height=64")[0] == 200,
+              "frames still draw after a refused view")
         diff = sum(abs(a - b) for pa, pb in zip(images["egl"].getdata(), images["osmesa"].getdata()) for a, b in zip(pa, pb))
         check(diff / (w * h * 3) < 2.0, f"EGL and OSMesa differ by {diff / (w * h * 3):.2f} levels on average")
         # The MJPEG stream: new frames while a job moves the surface.
