@@ -2,6 +2,8 @@
 // marching cubes) and pixel measures on RGB8 images.
 #pragma once
 
+#include <gtest/gtest.h>
+
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -14,6 +16,7 @@
 #include "render/image_codec.hpp"
 #include "render/offscreen_context.hpp"
 #include "render/scene.hpp"
+#include "render/scene_renderer.hpp"
 #include "render/view_settings.hpp"
 #include "surface/marching_cubes.hpp"
 
@@ -72,4 +75,30 @@ inline void dump(const render::Image& img, const std::string& name) {
     }
   }
 }
+}  // namespace levelset::test
+
+namespace levelset::test {
+
+// A context of the parameter's kind (creation throws: the test fails, never skips) and a
+// renderer on it, for the render test suites.
+class RenderFixture : public ::testing::TestWithParam<render::ContextKind> {
+ protected:
+  void SetUp() override {
+    context = render::create_offscreen_context(GetParam());
+    renderer = std::make_unique<render::SceneRenderer>(context->gl());
+  }
+  void TearDown() override {
+    renderer.reset();
+    context.reset();
+  }
+  std::unique_ptr<render::OffscreenContext> context;
+  std::unique_ptr<render::SceneRenderer> renderer;
+};
+
+// The analytic sphere at resolution 64, built once per test binary.
+inline const render::SceneData& sphere_scene() {
+  static const render::SceneData s = shape_scene("sphere", 64);
+  return s;
+}
+
 }  // namespace levelset::test

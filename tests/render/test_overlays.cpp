@@ -16,24 +16,9 @@ using levelset::test::foreground;
 
 namespace {
 
-class Overlays : public ::testing::TestWithParam<ContextKind> {
- protected:
-  void SetUp() override {
-    context = create_offscreen_context(GetParam());
-    renderer = std::make_unique<SceneRenderer>(context->gl());
-  }
-  void TearDown() override {
-    renderer.reset();
-    context.reset();
-  }
-  std::unique_ptr<OffscreenContext> context;
-  std::unique_ptr<SceneRenderer> renderer;
-};
+class Overlays : public test::RenderFixture {};
 
-const SceneData& sphere() {
-  static const SceneData s = test::shape_scene("sphere", 64);
-  return s;
-}
+const SceneData& sphere() { return test::sphere_scene(); }
 
 SceneData band_only(const SceneData& s) { return SceneData{{}, {}, s.band}; }
 

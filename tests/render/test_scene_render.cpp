@@ -13,24 +13,9 @@ using levelset::test::foreground;
 
 namespace {
 
-class SceneRender : public ::testing::TestWithParam<ContextKind> {
- protected:
-  void SetUp() override {
-    context = create_offscreen_context(GetParam());  // throws (fails the test) when no context
-    renderer = std::make_unique<SceneRenderer>(context->gl());
-  }
-  void TearDown() override {
-    renderer.reset();
-    context.reset();
-  }
-  std::unique_ptr<OffscreenContext> context;
-  std::unique_ptr<SceneRenderer> renderer;
-};
+class SceneRender : public test::RenderFixture {};
 
-const SceneData& sphere() {
-  static const SceneData s = test::shape_scene("sphere", 64);
-  return s;
-}
+const SceneData& sphere() { return test::sphere_scene(); }
 
 // The sphere's expected silhouette radius with the fitted camera (the mesh's box).
 double sphere_rho(const SceneRenderer& r, const ViewSettings& v) {
