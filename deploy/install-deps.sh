@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # The one list of Debian (bookworm) packages levelset needs to build, test and run.
 # Idempotent: installs only what is missing, then unpacks CGAL's sample data once.
-# Usage: deploy/install-deps.sh [build] [runtime] [test]   (default: all; as root, or via sudo)
+# Usage: deploy/install-deps.sh [build] [runtime] [gui] [test] [container]
+#        (default: build runtime gui test; as root, or via sudo)
 #        deploy/install-deps.sh list-runtime              (prints the runtime group)
 set -euo pipefail
 
@@ -9,7 +10,9 @@ set -euo pipefail
 # container's final stage runtime only (deploy/Dockerfile reads the runtime group from here).
 #   build:   compile levelsetd and the libraries (headers and toolchain)
 #   runtime: what the levelsetd binary loads (shared libraries, Mesa for offscreen frames)
+#   gui:     the desktop client levelset-gui (window, control panel)
 #   test:    tests, fuzzing and benchmarks (and the data and tools they use)
+#   container: make container-test only (image build and run on this machine)
 BUILD_PACKAGES=(
   # toolchain
   build-essential cmake ninja-build ccache pkg-config git
@@ -29,6 +32,10 @@ RUNTIME_PACKAGES=(
   libtbb12 libzstd1 libxxhash0 zlib1g libcpp-httplib0.11 libspdlog1.10 libfmt9 libssl3 libbrotli1
   libegl1 libopengl0 libegl-mesa0 libgl1-mesa-dri libosmesa6 libturbojpeg0 libpng16-16 libmeshoptimizer2d
   ca-certificates
+)
+GUI_PACKAGES=(
+  # levelset-gui: GLFW window + Dear ImGui panel (libimgui.a holds the glfw/opengl3 backends)
+  libglfw3-dev libimgui-dev
 )
 TEST_PACKAGES=(
   # libFuzzer runs (make fuzz): clang with its fuzzer/sanitizer runtimes
@@ -50,19 +57,27 @@ TEST_PACKAGES=(
   chromium chromium-driver python3-selenium
   # reconstruction benchmark reference: Open3D's screened Poisson
   python3-open3d
+  # desktop client tests: the real client under a virtual X server
+  xvfb xauth
+)
+CONTAINER_PACKAGES=(
+  # make container-test: a local base image from the apt mirror, docker on its own socket
+  debootstrap docker.io
 )
 
 # Groups named on the command line (default: all of them).
 WANTED=("$@")
-[ ${#WANTED[@]} -eq 0 ] && WANTED=(build runtime test)
+[ ${#WANTED[@]} -eq 0 ] && WANTED=(build runtime gui test)
 PACKAGES=()
 for g in "${WANTED[@]}"; do
   case "$g" in
     build) PACKAGES+=("${BUILD_PACKAGES[@]}") ;;
     runtime) PACKAGES+=("${RUNTIME_PACKAGES[@]}") ;;
+    gui) PACKAGES+=("${GUI_PACKAGES[@]}") ;;
     test) PACKAGES+=("${TEST_PACKAGES[@]}") ;;
+    container) PACKAGES+=("${CONTAINER_PACKAGES[@]}") ;;
     list-runtime) printf '%s\n' "${RUNTIME_PACKAGES[@]}"; exit 0 ;;
-    *) echo "install-deps: unknown group '$g' (build, runtime, test, list-runtime)" >&2; exit 2 ;;
+    *) echo "install-deps: unknown group '$g' (build, runtime, gui, test, container, list-runtime)" >&2; exit 2 ;;
   esac
 done
 
