@@ -228,7 +228,9 @@ void SceneRenderer::State::draw(const ViewSettings& view) {
 
   // The point cloud.
   constexpr float kAll = 3.0e38f;
-  draw_markers(cloud, GL_POINTS, mvp, 2.0f, -kAll, kAll, 0.0f, glm::vec3(0.55f, 0.85f, 0.45f));
+  if (view.cloud)
+    draw_markers(cloud, GL_POINTS, mvp, float(view.cloud_size), -kAll, kAll, 0.0f,
+                 glm::vec3(view.cloud_color[0], view.cloud_color[1], view.cloud_color[2]));
 
   // The band's overlays.
   if (band) {

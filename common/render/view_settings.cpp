@@ -91,7 +91,8 @@ SliceAxis axis_of(const std::string& place, const json& v) {
 
 constexpr const char* kFlatKeys =
     "width, height, shading, moving, yaw, pitch, zoom, distance, fov, target, light, background, color, field, "
-    "field_min, field_max, vectors, curvature, boundary, slice, slice_position, volume, volume_width, volume_opacity";
+    "field_min, field_max, vectors, curvature, boundary, slice, slice_position, volume, volume_width, volume_opacity, "
+    "cloud, cloud_size, cloud_color";
 
 // One setting by its flat (URL) name; `place` names it in errors.
 void set_flat(ViewSettings& view, const std::string& key, const json& v, const std::string& place) {
@@ -123,10 +124,13 @@ void set_flat(ViewSettings& view, const std::string& key, const json& v, const s
   else if (key == "volume") view.volume = boolean(place, v);
   else if (key == "volume_width") view.volume_width = number(place, v, 0, 1e12);
   else if (key == "volume_opacity") view.volume_opacity = number(place, v, 0, 1);
+  else if (key == "cloud") view.cloud = boolean(place, v);
+  else if (key == "cloud_size") view.cloud_size = number(place, v, 1, 32);
+  else if (key == "cloud_color") view.cloud_color = rgb(place, v);
   else throw Error(ErrorCode::InvalidArgument, place, std::string("unknown view setting (") + kFlatKeys + ")");
 }
 
-// A nested object ("camera", "field", "slice", "volume"): its keys mapped to flat names.
+// A nested object ("camera", "field", "slice", "volume", "cloud"): its keys mapped to flat names.
 void set_group(ViewSettings& view, const std::string& group, const json& object) {
   for (const auto& [k, v] : object.items()) {
     const std::string place = "view." + group + "." + sanitize_utf8(k.substr(0, 40));
@@ -137,6 +141,7 @@ void set_group(ViewSettings& view, const std::string& group, const json& object)
     else if (group == "slice" && k == "axis") flat = "slice";
     else if (group == "slice" && k == "position") flat = "slice_position";
     else if (group == "volume" && (k == "width" || k == "opacity")) flat = "volume_" + k;
+    else if (group == "cloud" && (k == "size" || k == "color")) flat = "cloud_" + k;
     const bool camera_key = flat == "yaw" || flat == "pitch" || flat == "zoom" || flat == "distance" ||
                             flat == "fov" || flat == "target";
     if (flat.empty() || (group == "camera" && !camera_key))
@@ -181,7 +186,7 @@ void merge_json(ViewSettings& view, const json& settings) {
   if (!settings.is_object()) throw Error(ErrorCode::InvalidArgument, "view", "expected an object of view settings");
   ViewSettings next = view;  // all or nothing
   for (const auto& [key, value] : settings.items()) {
-    const bool group = key == "camera" || key == "field" || key == "slice" || key == "volume";
+    const bool group = key == "camera" || key == "field" || key == "slice" || key == "volume" || key == "cloud";
     if (group && value.is_object()) set_group(next, key, value);
     else if (key == "camera") throw Error(ErrorCode::InvalidArgument, "view.camera", "expected an object");
     else set_flat(next, key, value, "view." + sanitize_utf8(key.substr(0, 40)));
@@ -216,7 +221,8 @@ json to_json(const ViewSettings& v) {
           {"curvature", v.curvature},
           {"boundary", v.boundary},
           {"slice", {{"axis", to_string(v.slice)}, {"position", v.slice_position}}},
-          {"volume", {{"on", v.volume}, {"width", v.volume_width}, {"opacity", v.volume_opacity}}}};
+          {"volume", {{"on", v.volume}, {"width", v.volume_width}, {"opacity", v.volume_opacity}}},
+          {"cloud", {{"on", v.cloud}, {"size", v.cloud_size}, {"color", v.cloud_color}}}};
 }
 
 void apply_query(ViewSettings& view, const std::string& key, const std::string& value) {

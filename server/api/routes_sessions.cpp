@@ -182,7 +182,7 @@ void add_session_routes(std::vector<Route>& r) {
   r.push_back({"GET", "/api/v1/sessions/{id}", "One session: name, version, band summary, running job", false, false,
                {}, nullptr, {{"200", "the session"}, {"404", "unknown"}},
                [](RouteContext& c) { c.reply(200, c.service.sessions().get(c.param(1))->describe()); }});
-  r.push_back({"PATCH", "/api/v1/sessions/{id}", "Rename: {\"name\": NEW}", true, false, {}, kJson,
+  r.push_back({"PATCH", "/api/v1/sessions/{id}", "Rename ({\"name\": NEW}) and/or show a point upload with the session ({\"points\": UPLOAD_ID}, null: none)", true, false, {}, kJson,
                {{"200", "the session"}}, [](RouteContext& c) { c.reply(200, c.service.patch_session(c.param(1), c.body())); }});
   r.push_back({"DELETE", "/api/v1/sessions/{id}", "Delete a session and its files", true, false, {}, nullptr,
                {{"204", "deleted"}, {"409", "a job runs on it"}}, [](RouteContext& c) {

@@ -51,10 +51,13 @@ EncodedFrame Service::frame(const std::string& session_id, const FrameRequest& s
   auto s = sessions_->get(session_id);
   FrameRequest r = settings;
   const std::uint64_t serial = s->preview_serial();
+  const std::uint64_t cloud = s->points_serial();
   r.band = s->preview();
+  r.points = s->points();
   r.view = s->view();
-  r.scene_key = session_id + "-v" + std::to_string(s->version()) + "-p" + std::to_string(serial);
-  if (state != nullptr) *state = serial * 1000003 + s->view_serial();
+  r.scene_key = session_id + "-v" + std::to_string(s->version()) + "-p" + std::to_string(serial) + "-c" +
+                std::to_string(cloud);
+  if (state != nullptr) *state = (serial * 1000003 + s->view_serial()) * 1009 + cloud;
   return render_->render(std::move(r), std::chrono::seconds(30));
 }
 
@@ -190,12 +193,34 @@ Reply Service::create_session(const json& body) {
 
 json Service::patch_session(const std::string& id, const json& body) {
   auto s = sessions_->get(id);
-  if (!body.is_object() || !body.contains("name") || !body["name"].is_string())
-    throw bad_request("expected {\"name\": NEW_NAME}");
-  const std::string name = body["name"].get<std::string>();
-  if (name.empty() || name.size() > 200) throw unprocessable("body.name", "expected 1 to 200 characters");
-  sessions_->rename(*s, name);
+  if (!body.is_object() || (!body.contains("name") && !body.contains("points")))
+    throw bad_request("expected {\"name\": NEW_NAME} and/or {\"points\": UPLOAD_ID | null}");
+  for (const auto& [key, value] : body.items())
+    if (key != "name" && key != "points") throw unprocessable("body." + key.substr(0, 40), "unknown field (name, points)");
+  std::string name;
+  if (body.contains("name")) {
+    if (!body["name"].is_string()) throw unprocessable("body.name", "expected a string");
+    name = body["name"].get<std::string>();
+    if (name.empty() || name.size() > 200) throw unprocessable("body.name", "expected 1 to 200 characters");
+  }
+  if (body.contains("points") && !body["points"].is_null() && !body["points"].is_string())
+    throw unprocessable("body.points", "expected an upload id or null");
+  if (body.contains("points")) {  // checked before the rename: all or nothing
+    if (body["points"].is_null()) sessions_->detach_points(*s);
+    else attach_points(*s, body["points"].get<std::string>(), "body.points");
+  }
+  if (!name.empty()) sessions_->rename(*s, name);
   return s->describe();
+}
+
+void Service::attach_points(Session& s, const std::string& upload_id, const std::string& place) {
+  const json meta = uploads_->get(upload_id);
+  if (meta.value("kind", "") != "points")
+    throw unprocessable(place, "upload " + upload_id + " is a " + meta.value("kind", "file") + ", not a point cloud");
+  const json summary = meta.value("summary", json::object());
+  sessions_->attach_points(s, uploads_->path_of(upload_id),
+                           {{"upload", upload_id}, {"format", meta.value("format", "xyz")},
+                            {"points", summary.value("points", 0)}});
 }
 
 Reply Service::snapshot(const std::string& id, const json& body) {

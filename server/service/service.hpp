@@ -78,6 +78,8 @@ class Service {
   // Sessions.
   nlohmann::json list_sessions() const;
   Reply create_session(const nlohmann::json& body);  // 201 (primitive, band upload) or 202 (a job)
+  // {"name": NEW} renames; {"points": UPLOAD | null} shows a point upload with the session (or
+  // stops showing its cloud). Either or both.
   nlohmann::json patch_session(const std::string& id, const nlohmann::json& body);
   Reply snapshot(const std::string& id, const nlohmann::json& body);
   nlohmann::json restore(const std::string& id, const std::string& snapshot_id);
@@ -111,6 +113,8 @@ class Service {
   void load_journal();
   std::shared_ptr<Job> make_job(const nlohmann::json& request, const std::string& session_id);
   std::filesystem::path job_dir(const std::string& job_id) const;
+  // Keeps a point upload with a session (422 at `place` when the upload is not a point cloud).
+  void attach_points(Session& s, const std::string& upload_id, const std::string& place);
   // Grid boxes of bands built from shapes and meshes: 64x the voxels a session may hold, so a
   // request for an absurd resolution is refused before any work, not after minutes of it.
   std::uint64_t domain_budget() const { return config_.max_session_voxels * 64; }

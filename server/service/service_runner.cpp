@@ -251,6 +251,7 @@ class Service::JobRun {
                                             std::move(*r.band), {{"job", job_.id()}, {"params", job_.request()}});
       result["session"] = created->id();
       result["version"] = 1;
+      show_input_points(*created);
     }
     if (session_) svc_.sessions_->drop_checkpoint(*session_, job_.id());
     json done = {{"fraction", 1.0}, {"stage", "done"}};
@@ -262,6 +263,17 @@ class Service::JobRun {
     job_.set_state(JobState::Succeeded,
                    {{"result", result}, {"seconds", std::chrono::duration<double>(Clock::now() - started_).count()}});
     ++svc_.jobs_succeeded_;
+  }
+
+  // A session made from a point upload (reconstruct) shows those points in its frames.
+  void show_input_points(Session& created) {
+    const json input = job_.request().value("input", json::object());
+    if (!input.is_object() || !input.contains("points") || !input["points"].is_string()) return;
+    try {
+      svc_.attach_points(created, input["points"].get<std::string>(), "input.points");
+    } catch (const std::exception& e) {  // the session stands without its cloud
+      job_.log(std::string("warning: the point cloud is not kept with the session: ") + e.what());
+    }
   }
 
   void fail(json error, int status) {

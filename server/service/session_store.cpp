@@ -5,6 +5,7 @@
 #include "core/error.hpp"
 #include "core/file_io.hpp"
 #include "grid/lsg_file.hpp"
+#include "io/point_cloud_reader.hpp"
 #include "service/api_error.hpp"
 #include "service/ids.hpp"
 #include "service/render_service.hpp"
@@ -71,9 +72,29 @@ json Session::describe() const {
             {"source", meta_.value("source", json::object())},
             {"history_length", meta_.value("history", json::array()).size()},
             {"snapshots", meta_.value("snapshots", json::array()).size()},
-            {"running_job", running_job_.empty() ? json(nullptr) : json(running_job_)}};
+            {"running_job", running_job_.empty() ? json(nullptr) : json(running_job_)},
+            {"points", meta_.value("points", json(nullptr))}};
   if (band_) j["band"] = summary_;
   return j;
+}
+
+std::shared_ptr<const PointCloud> Session::points() const {
+  std::string file;
+  {
+    std::lock_guard lock(mutex_);
+    if (!meta_.contains("points") || !meta_["points"].is_object()) return nullptr;
+    file = meta_["points"].value("file", "");
+  }
+  std::lock_guard lock(points_mutex_);
+  if (!points_ || points_file_ != file) {  // file names carry the upload id: a new cloud, a new name
+    points_file_ = file;
+    try {
+      points_ = std::make_shared<const PointCloud>(read_point_cloud(dir_ / file).cloud);
+    } catch (const Error&) {  // a damaged copy: frames go on without it (describe() still names it)
+      points_ = std::make_shared<const PointCloud>();
+    }
+  }
+  return points_;
 }
 
 json Session::history() const {
@@ -287,6 +308,47 @@ void SessionStore::set_preview(Session& s, std::shared_ptr<const NarrowBand> ban
 }
 
 void SessionStore::clear_preview(Session& s) { set_preview(s, nullptr); }
+
+void SessionStore::attach_points(Session& s, const fs::path& file, json info) {
+  const std::string name = "points-" + info.value("upload", "cloud") + "." + info.value("format", "xyz");
+  const fs::path target = s.dir_ / name, temp = s.dir_ / (name + ".tmp-attach");
+  std::error_code ec;
+  fs::remove(temp, ec);
+  fs::create_hard_link(file, temp, ec);
+  if (ec) {
+    ec.clear();
+    fs::copy_file(file, temp, fs::copy_options::overwrite_existing, ec);
+  }
+  if (!ec) fs::rename(temp, target, ec);
+  if (ec) {
+    fs::remove(temp, ec);
+    throw Error(ErrorCode::IoError, name, "cannot keep the point cloud with the session: " + ec.message());
+  }
+  info["file"] = name;
+  {
+    std::lock_guard lock(s.mutex_);
+    const std::string old = s.meta_.contains("points") ? s.meta_["points"].value("file", "") : "";
+    s.meta_["points"] = info;
+    write_meta(s);
+    if (!old.empty() && old != name) fs::remove(s.dir_ / old, ec);
+  }
+  s.points_serial_.fetch_add(1);
+  s.events().publish("points", info);
+}
+
+void SessionStore::detach_points(Session& s) {
+  {
+    std::lock_guard lock(s.mutex_);
+    if (!s.meta_.contains("points")) return;
+    const std::string old = s.meta_["points"].value("file", "");
+    s.meta_.erase("points");
+    write_meta(s);
+    std::error_code ec;
+    if (!old.empty()) fs::remove(s.dir_ / old, ec);
+  }
+  s.points_serial_.fetch_add(1);
+  s.events().publish("points", nullptr);
+}
 
 json SessionStore::update_view(Session& s, const json& changes) {
   json view;

@@ -25,6 +25,7 @@
 #include <nlohmann/json.hpp>
 
 #include "grid/narrow_band.hpp"
+#include "io/triangle_mesh.hpp"
 #include "service/event_log.hpp"
 
 namespace levelset::service {
@@ -50,6 +51,10 @@ class Session {
   nlohmann::json history() const;
   nlohmann::json snapshots() const;
   nlohmann::json view() const;  // the camera and display settings of this session's frames
+  // The session's point cloud (its reconstruction input, or a point upload attached with PATCH),
+  // read on first use and kept; null when it has none. points_serial() changes with it.
+  std::shared_ptr<const PointCloud> points() const;
+  std::uint64_t points_serial() const { return points_serial_.load(); }
   EventLog& events() { return events_; }
 
   // One job at a time: claim() is false when another holds the session.
@@ -65,7 +70,10 @@ class Session {
   nlohmann::json meta_ = nlohmann::json::object();  // what session.json holds
   std::shared_ptr<const NarrowBand> band_, preview_;
   nlohmann::json summary_;  // band_summary(*band_), computed once per version (GETs are hot)
-  std::atomic<std::uint64_t> preview_serial_{0}, view_serial_{0};
+  std::atomic<std::uint64_t> preview_serial_{0}, view_serial_{0}, points_serial_{0};
+  mutable std::mutex points_mutex_;  // reading the cloud does not hold mutex_
+  mutable std::shared_ptr<const PointCloud> points_;
+  mutable std::string points_file_;
   std::string running_job_;
   EventLog events_;
 };
@@ -90,6 +98,10 @@ class SessionStore {
   // Merges `changes` into the session's view settings (kept in session.json); publishes "view".
   nlohmann::json update_view(Session& s, const nlohmann::json& changes);
   void clear_preview(Session& s);
+  // Keeps a copy of a point-cloud file (a hard link when it can) as the session's cloud; `info`
+  // (upload id, format, point count) is what describe() shows. Publishes "points".
+  void attach_points(Session& s, const std::filesystem::path& file, nlohmann::json info);
+  void detach_points(Session& s);
 
   nlohmann::json snapshot(Session& s, const std::string& replica, const std::string& name);
   std::uint64_t restore(Session& s, const std::string& snapshot_id);

@@ -135,6 +135,23 @@ def test_reconstruct_kitten():
         final = d.get(f"/api/v1/jobs/{job['id']}")[2]
         check(final["state"] == "succeeded", f"job: {final}")
         sid = final["result"]["session"]
+        # The reconstruction input stays with the session and shows in its frames (table 4.1 I).
+        info = d.get(f"/api/v1/sessions/{sid}")[2]
+        check(info["points"] and info["points"]["upload"] == up["id"] and info["points"]["points"] == up["summary"]["points"],
+              f"the session keeps its input points: {info.get('points')}")
+        cloud_only = f"/api/v1/sessions/{sid}/frame?width=640&height=480&format=png&shading=none"
+        shown = foreground(decode(d.request("GET", cloud_only)[2]))
+        check(shown > 500, f"the point cloud draws: {shown} px")
+        check(foreground(decode(d.request("GET", cloud_only + "&cloud=off")[2])) == 0, "cloud=off hides it")
+        check(d.request("DELETE", f"/api/v1/uploads/{up['id']}")[0] == 204, "the upload can go")
+        bigger = foreground(decode(d.request("GET", cloud_only + "&cloud_size=4")[2]))
+        check(bigger > 1.5 * shown, f"the session's copy outlives the upload; bigger points cover more: {bigger} vs {shown}")
+        status, _, body = d.json_request("PATCH", f"/api/v1/sessions/{sid}", {"points": None})
+        check(status == 200 and body["points"] is None, f"PATCH points null: {status} {body}")
+        check(foreground(decode(d.request("GET", cloud_only)[2])) == 0, "a detached cloud no longer draws")
+        status, _, mesh_up = upload(d, os.path.join(CGAL, "meshes", "knot1.off"), "off")
+        status, _, body = d.json_request("PATCH", f"/api/v1/sessions/{sid}", {"points": mesh_up["id"]})
+        check(status == 422 and body["error"]["details"]["field"] == "body.points", f"a mesh is not a point cloud: {status} {body}")
         status, hdrs, mesh = d.request("GET", f"/api/v1/sessions/{sid}/mesh?format=off")
         check(status == 200 and hdrs.get("ETag"), "mesh download with an ETag")
         served = off_topology(mesh.decode())

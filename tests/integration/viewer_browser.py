@@ -76,8 +76,38 @@ try:
     lines = driver.find_element(By.ID, "formula-error").text.split("\n")
     check(lines[0] == "1 + * k1" and lines[1].index("^") == 4, f"formula error: {lines}")
     check(driver.find_element(By.ID, "view-message").text == "", "no error over the view")
+    # Display settings become the session's view (PUT .../view) and the stream follows them.
+    sid = sessions[0]["id"]
+    shown = driver.find_element(By.ID, "stream").screenshot_as_png
+    driver.find_element(By.ID, "shading").send_keys("wireframe")
+    driver.find_element(By.CSS_SELECTOR, "[data-view=boundary]").click()
+    wait.until(lambda _: d.get(f"/api/v1/sessions/{sid}/view")[2].get("boundary") is True)
+    stored = d.get(f"/api/v1/sessions/{sid}/view")[2]
+    check(stored["shading"] == "wireframe" and stored["cloud"]["on"] is True, f"stored view: {stored}")
+    wait.until(lambda _: driver.find_element(By.ID, "stream").screenshot_as_png != shown)
+    # A point cloud from this computer: uploaded, reconstructed into a session that shows it.
+    import math
+    cloud = os.path.join(SCRATCH, "ball.xyz")
+    with open(cloud, "w") as f:
+        n = 4000
+        for i in range(n):
+            z = 1 - 2 * (i + 0.5) / n
+            r, a = math.sqrt(1 - z * z), i * 2.399963229728653
+            f.write(f"{r * math.cos(a):.6f} {r * math.sin(a):.6f} {z:.6f}\n")
+    driver.find_element(By.ID, "file").send_keys(cloud)
+    res = driver.find_element(By.ID, "upload-resolution")
+    res.clear()
+    res.send_keys("48")
+    driver.execute_script("current = null")  # as on a fresh page: nothing selected
+    driver.find_element(By.ID, "upload").click()
+    wait.until(lambda _: len(d.get("/api/v1/sessions")[2]["sessions"]) == 2)
+    made = [s for s in d.get("/api/v1/sessions")[2]["sessions"] if s["id"] != sid][0]
+    check(made["name"] == "ball.xyz" and made["points"]["points"] == 4000, f"the uploaded session keeps its points: {made}")
+    wait.until(lambda _: driver.execute_script("return current") == made["id"])
+    check(driver.find_element(By.ID, "session-error").text == "", "no upload error")
     driver.save_screenshot(os.path.join(SCRATCH, "viewer.png"))
 finally:
     driver.quit()
     d.stop()
-print("viewer_browser: the page created a session, streamed it, ran a job to 100 % with the view changing, showed a formula error at its column")
+print("viewer_browser: the page created a session, streamed it, ran a job to 100 % with the view changing, showed a "
+      "formula error at its column, steered the display, and made a session from an uploaded point cloud")

@@ -156,6 +156,19 @@ TEST_P(SceneRender, PointCloud) {
         ASSERT_LT(std::hypot(x + 0.5 - 160, y + 0.5 - 120), rho + 3);
       }
     }
+  // Table 4.1 I: the cloud's shading. Off draws nothing; bigger points cover more; the colour
+  // is the one asked for.
+  v.cloud = false;
+  EXPECT_EQ(foreground(renderer->render(v)), 0u);
+  v.cloud = true;
+  v.cloud_size = 5;
+  v.cloud_color = {1.0f, 0.0f, 0.0f};
+  const Image big = renderer->render(v);
+  EXPECT_GT(double(foreground(big)), 1.5 * double(n));
+  std::size_t red = 0;
+  for (std::size_t i = 0; i + 2 < big.rgb.size(); i += 3)
+    red += big.rgb[i] > 200 && big.rgb[i + 1] < 40 && big.rgb[i + 2] < 40;
+  EXPECT_EQ(red, foreground(big));
 }
 
 TEST_P(SceneRender, RefusesBadSizes) {

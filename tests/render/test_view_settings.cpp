@@ -30,6 +30,7 @@ TEST(ViewSettings, JsonRoundTripKeepsEveryField) {
   v.light = {1, 0, 0};
   v.field = true, v.range_min = -0.1, v.vectors = true, v.curvature = true, v.boundary = true;
   v.slice = SliceAxis::Y, v.slice_position = 0.25, v.volume = true, v.volume_width = 0.2, v.volume_opacity = 0.3;
+  v.cloud = false, v.cloud_size = 4, v.cloud_color = {0.5f, 0.25f, 1.0f};
   const ViewSettings w = from_json(to_json(v));
   EXPECT_EQ(to_json(w), to_json(v));
   EXPECT_EQ(w.camera.target->z, 3);
@@ -59,6 +60,9 @@ TEST(ViewSettings, QueryParameters) {
   apply_query(v, "slice_position", "0.75");
   apply_query(v, "moving", "1");
   apply_query(v, "width", "1024");
+  apply_query(v, "cloud", "off");
+  apply_query(v, "cloud_size", "6");
+  apply_query(v, "cloud_color", "1,0,0");
   EXPECT_EQ(v.shading, Shading::Flat);
   EXPECT_EQ(v.camera.target->y, 2);
   EXPECT_EQ(v.light[1], 1);
@@ -68,6 +72,9 @@ TEST(ViewSettings, QueryParameters) {
   EXPECT_EQ(v.slice, SliceAxis::X);
   EXPECT_TRUE(v.moving);
   EXPECT_EQ(v.width, 1024);
+  EXPECT_FALSE(v.cloud);
+  EXPECT_EQ(v.cloud_size, 6);
+  EXPECT_EQ(v.cloud_color[0], 1.0f);
 }
 
 TEST(ViewSettings, ErrorsNameTheSettingAndChangeNothing) {
@@ -81,6 +88,8 @@ TEST(ViewSettings, ErrorsNameTheSettingAndChangeNothing) {
   EXPECT_EQ(error_place([&] { merge_json(v, {{"camera", {{"shading", "flat"}}}}); }), "view.camera.shading");
   EXPECT_EQ(error_place([&] { merge_json(v, {{"slice", {{"position", 2}}}}); }), "view.slice.position");
   EXPECT_EQ(error_place([&] { merge_json(v, {{"background", {1, 2}}}); }), "view.background");
+  EXPECT_EQ(error_place([&] { merge_json(v, {{"cloud", {{"size", 0}}}}); }), "view.cloud.size");
+  EXPECT_EQ(error_place([&] { merge_json(v, {{"cloud", {{"shape", "disc"}}}}); }), "view.cloud.shape");
   EXPECT_EQ(error_place([&] { merge_json(v, {{"yaw", 10}, {"volume", {{"opacity", -1}}}}); }), "view.volume.opacity");
   EXPECT_EQ(to_json(v), to_json(ViewSettings{}));  // the yaw of the failed merge did not stick
   try {
