@@ -46,8 +46,8 @@ service::FrameRequest frame_settings(const httplib::Request& req) {
   return f;
 }
 
-// MJPEG: a new part whenever the session's state (a step, a version) or view changed, at most
-// 15 a second; the provider draws the newest state when the client is ready for it, so a slow
+// MJPEG: a new part whenever the session's state (a step, a version), view or point cloud
+// changed, at most stream_fps a second; the provider draws the newest state when the client is ready for it, so a slow
 // client skips frames instead of queueing them.
 void stream_frames(RouteContext& c) {
   service::Service& svc = c.service;
@@ -69,13 +69,13 @@ void stream_frames(RouteContext& c) {
   c.res.set_chunked_content_provider(
       "multipart/x-mixed-replace; boundary=levelsetframe",
       [&svc, session, settings, cursor](std::size_t, httplib::DataSink& sink) {
-        const auto min_gap = std::chrono::milliseconds(1000 / 15);
+        const auto min_gap = std::chrono::milliseconds(1000 / svc.config().stream_fps);
         for (int waited = 0; waited < 10; ++waited) {  // at most ~1 s in one call
           if (!svc.ready()) {
             sink.done();
             return true;
           }
-          const std::uint64_t now_state = session->preview_serial() * 1000003 + session->view_serial();
+          const std::uint64_t now_state = session->frame_state();
           if (now_state != cursor->state) {
             const auto since = std::chrono::steady_clock::now() - cursor->last;
             if (since < min_gap) std::this_thread::sleep_for(min_gap - since);

@@ -57,7 +57,7 @@ EncodedFrame Service::frame(const std::string& session_id, const FrameRequest& s
   r.view = s->view();
   r.scene_key = session_id + "-v" + std::to_string(s->version()) + "-p" + std::to_string(serial) + "-c" +
                 std::to_string(cloud);
-  if (state != nullptr) *state = (serial * 1000003 + s->view_serial()) * 1009 + cloud;
+  if (state != nullptr) *state = (serial * 1000003 + s->view_serial()) * 1009 + cloud;  // = frame_state()
   return render_->render(std::move(r), std::chrono::seconds(30));
 }
 

@@ -125,6 +125,8 @@ const std::vector<ServiceOption>& service_options() {
       size("max_body_bytes", "Size of a JSON request body; beyond it 413", &ServiceConfig::max_body_bytes),
       integer("max_formula_length", "Characters in a speed formula", &ServiceConfig::max_formula_length, 16, 1 << 20),
       integer("max_streams", "Open event and frame streams; beyond it 503", &ServiceConfig::max_streams, 1, 4096),
+      integer("stream_fps", "MJPEG frames per second at most (a slow client gets the newest, skipping the rest)",
+              &ServiceConfig::stream_fps, 1, 120),
       seconds("checkpoint_seconds", "Checkpoint a long job this often", &ServiceConfig::checkpoint_seconds),
       seconds("shutdown_deadline", "On SIGTERM, stop jobs and exit within this time", &ServiceConfig::shutdown_deadline),
       seconds("read_timeout", "Drop a client that sends nothing for this long", &ServiceConfig::read_timeout),

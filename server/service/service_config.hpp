@@ -38,6 +38,7 @@ struct ServiceConfig {
   std::uint64_t max_body_bytes = std::uint64_t{4} << 20;  // JSON bodies
   int max_formula_length = 4096;
   int max_streams = 64;             // open SSE / MJPEG streams
+  int stream_fps = 15;              // MJPEG parts per second at most
   double checkpoint_seconds = 30;
   double shutdown_deadline = 10;
   double read_timeout = 30;         // against slow senders

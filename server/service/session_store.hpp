@@ -55,6 +55,10 @@ class Session {
   // read on first use and kept; null when it has none. points_serial() changes with it.
   std::shared_ptr<const PointCloud> points() const;
   std::uint64_t points_serial() const { return points_serial_.load(); }
+  // Changes whenever a frame of the session would: its band state, view or point cloud.
+  std::uint64_t frame_state() const {
+    return (preview_serial_.load() * 1000003 + view_serial_.load()) * 1009 + points_serial_.load();
+  }
   EventLog& events() { return events_; }
 
   // One job at a time: claim() is false when another holds the session.

@@ -605,7 +605,7 @@ def test_frames():
     camera's projection, the shading modes, EGL and OSMesa agreeing, size limits, the stream."""
     import math
     d = Daemon(BIN, fresh("frames-egl"), "--render", "egl")
-    o = Daemon(BIN, fresh("frames-osmesa"), "--render", "osmesa")
+    o = Daemon(BIN, fresh("frames-osmesa"), "--render", "osmesa", "--max-streams", "1", "--stream-fps", "5")
     try:
         check("render: egl:" in d.read_log() and "render: osmesa:" in o.read_log(), "one log line names the renderer")
         w, h = 320, 240
@@ -672,6 +672,24 @@ def test_frames():
                     frames.append(r.read(n))
         d.json_request("DELETE", f"/api/v1/jobs/{job['id']}")
         check(all(decode(f).size == (160, 120) for f in frames), "stream frames decode at the requested size")
+        # Limits: stream_fps parts a second at most while a job moves the surface, and max_streams
+        # open streams (the next gets 503).
+        s = sphere_session(o, 48)
+        job = long_evolve(o, s["id"], steps=100000, speed="-(k1+k2)*0.02")
+        import time
+        deadline = time.monotonic() + 60  # polled, not followed: an event stream would take the one slot
+        while o.get(f"/api/v1/jobs/{job['id']}")[2]["progress"].get("step", 0) < 1 and time.monotonic() < deadline:
+            time.sleep(0.05)
+        with urllib.request.urlopen(f"{o.url}/api/v1/sessions/{s['id']}/stream?width=64&height=64", timeout=60) as r:
+            parts, start = 0, time.monotonic()
+            while time.monotonic() - start < 2.0:
+                if r.readline().lower().startswith(b"content-length:"):
+                    parts += 1
+            elapsed = time.monotonic() - start
+            check(2 <= parts <= 5 * elapsed + 2, f"{parts} parts in {elapsed:.1f} s at --stream-fps 5")
+            status, _, body = o.get(f"/api/v1/sessions/{s['id']}/stream")
+            check(status == 503 and body["error"]["code"] == "too_many_streams", f"a second stream: {status} {body}")
+        o.json_request("DELETE", f"/api/v1/jobs/{job['id']}")
         check(len(set(frames)) >= 3, f"the stream's frames change while the job runs: {len(set(frames))} distinct")
     finally:
         d.stop()
