@@ -10,6 +10,8 @@
 // --log: the reconstruction's per-level lines on stderr; --seeds A B: the sampling seeds A..B
 // (default 5 only); --levels L, --neighbors K: reconstruction options; --topology: no
 // distances, only watertight / genus / components per case (fast sample-set sweeps).
+// --sweep: every closed manifold CGAL mesh at several densities, noises and seeds with default
+// options (bench_reconstruct_sweep.cpp, issue 19).
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -24,6 +26,7 @@
 #include "apps/reconstruction.hpp"
 #include "apps/sample_points.hpp"
 #include "bench_support.hpp"
+#include "reconstruct_scoring.hpp"
 #include "core/file_io.hpp"
 #include "io/mesh_reader.hpp"
 #include "surface/mesh_measures.hpp"
@@ -32,31 +35,14 @@ namespace {
 
 using namespace levelset;
 
-struct Row {
-  double chamfer = 0, hausdorff = 0, seconds = 0, genus = 0;
-  bool watertight = false;
-};
-
-Row score(const TriangleMesh& truth, const std::vector<Vec3d>& truth_samples, const TriangleMesh& mesh, double seconds) {
-  apps::SurfaceSampleOptions s;
-  s.count = 200000;
-  s.seed = 7;
-  const std::vector<Vec3d> mesh_samples = apps::sample_mesh_surface(mesh, s);
-  const apps::MeshDistance to_truth(truth), to_mesh(mesh);
-  const apps::SurfaceDistance d = apps::surface_distance(
-      mesh_samples, [&](const Vec3d& p) { return to_truth.distance(p); }, truth_samples,
-      [&](const Vec3d& p) { return to_mesh.distance(p); });
-  const MeshMeasures m = measure_mesh(mesh);
-  return {d.chamfer, d.hausdorff, seconds, m.genus, m.watertight};
-}
-
-std::string script_path() {
-  return std::string(LEVELSET_BENCH_DIR) + "/poisson_reference.py";
-}
+using bench::Row;
+using bench::score;
 
 }  // namespace
 
 int main(int argc, char** argv) {
+  for (int a = 1; a < argc; ++a)
+    if (std::string(argv[a]) == "--sweep") return bench::run_reconstruct_sweep(argc, argv);
   const bool quick = bench::is_quick(argc, argv);
   bool ours_only = quick;
   bool log_stages = false;
@@ -144,29 +130,12 @@ int main(int argc, char** argv) {
           print("levelset", ours);
           ok = ok && ours.watertight;
           if (ours_only) continue;
-          const std::filesystem::path tmp = std::filesystem::temp_directory_path();
-          const std::string xyz = (tmp / "bench_reconstruct_points.xyz").string();
-          const std::string ply = (tmp / "bench_reconstruct_poisson.ply").string();
-          std::string text;
-          char line[96];
-          for (const Vec3d& p : points) text.append(line, std::size_t(std::snprintf(line, sizeof line, "%.17g %.17g %.17g\n", p.x, p.y, p.z)));
-          write_file_atomically(xyz, text);
-          const std::string cmd = "/usr/bin/python3 " + script_path() + " " + xyz + " " + ply + " 8 16";
-          std::FILE* pipe = popen(cmd.c_str(), "r");
-          std::string reply;
-          if (pipe != nullptr) {
-            std::array<char, 4096> buf{};
-            while (std::fgets(buf.data(), int(buf.size()), pipe) != nullptr) reply += buf.data();
-            pclose(pipe);
-          }
-          const auto json = nlohmann::json::parse(reply, nullptr, false);
-          if (json.is_discarded() || !json.contains("seconds")) {
-            std::printf("%-10s %7zu %6.3f%% | poisson   (reference failed: %s)\n", name, count, noise * 100, reply.c_str());
+          const bench::PoissonRun poisson = bench::run_poisson(points, "");
+          if (!poisson.ok) {
+            std::printf("%-10s %7zu %6.3f%% | poisson   (reference failed: %s)\n", name, count, noise * 100, poisson.error.c_str());
             continue;
           }
-          MeshReadOptions mo;
-          const TriangleMesh poisson = read_mesh(ply, mo).mesh;
-          print("poisson", score(truth, truth_samples, poisson, json["seconds"].get<double>()));
+          print("poisson", score(truth, truth_samples, poisson.mesh, poisson.seconds));
           }
         }
       }
