@@ -27,7 +27,7 @@ build: configure
 # levelsetd alone, in its own build folder without tests or benchmarks (issue 18: make run
 # built the unit tests, fuzz replays and OpenVDB benchmarks it never ran).
 build-run: deps-run
-	@cmake --preset $(PRESET) -B $(RUN_BUILD) -DLEVELSET_BUILD_TESTS=OFF -DLEVELSET_BUILD_BENCH=OFF >/dev/null
+	@cmake --preset $(PRESET) -B $(RUN_BUILD) -DLEVELSET_BUILD_TESTS=OFF -DLEVELSET_BUILD_BENCH=OFF -DLEVELSET_BUILD_GUI=OFF >/dev/null
 	@cmake --build $(RUN_BUILD) --target levelsetd -j $(JOBS)
 
 # Main job on an embedded default: the surface reconstruction from 20000 points sampled on

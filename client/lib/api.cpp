@@ -103,6 +103,11 @@ json Api::patch(const std::string& path, const json& body) const {
   return answer(server_, c->Patch(prefix_ + path, body.dump(), "application/json"));
 }
 
+json Api::put(const std::string& path, const json& body) const {
+  auto c = make_client(origin_, token_, 120);
+  return answer(server_, c->Put(prefix_ + path, body.dump(), "application/json"));
+}
+
 json Api::del(const std::string& path) const {
   auto c = make_client(origin_, token_, 120);
   return answer(server_, c->Delete(prefix_ + path));
@@ -200,7 +205,7 @@ std::uint64_t Api::download(const std::string& path, const std::string& file) co
 }
 
 void Api::events(const std::string& path, const std::string& last_event_id,
-                 const std::function<bool(const SseEvent&)>& on_event) const {
+                 const std::function<bool(const SseEvent&)>& on_event, const std::atomic<bool>* stop) const {
   httplib::Headers headers{{"Accept", "text/event-stream"}};
   if (!last_event_id.empty()) headers.emplace("Last-Event-ID", last_event_id);
   int status = 0;
@@ -221,6 +226,48 @@ void Api::events(const std::string& path, const std::string& last_event_id,
           return true;
         }
         if (!parser.feed(std::string_view(data, n), on_event)) stopped = true;
+        if (stop != nullptr && stop->load()) stopped = true;
+        return !stopped;
+      });
+  if (stopped) return;
+  if (!r) throw transport_error(server_, r.error());
+  if (status >= 400) throw ClientError::from_response(status, error_body);
+}
+
+Api::Raw Api::get_raw(const std::string& path, const std::string& etag) const {
+  httplib::Headers headers;
+  if (!etag.empty()) headers.emplace("If-None-Match", etag);
+  auto c = make_client(origin_, token_, 120);
+  auto r = c->Get(prefix_ + path, headers);
+  if (!r) throw transport_error(server_, r.error());
+  if (r->status >= 400) throw ClientError::from_response(r->status, r->body);
+  Raw raw;
+  raw.status = r->status;
+  raw.etag = r->get_header_value("ETag");
+  raw.content_type = r->get_header_value("Content-Type");
+  if (r->status != 304) raw.body = std::move(r->body);
+  return raw;
+}
+
+void Api::get_stream(const std::string& path, std::string* content_type,
+                     const std::function<bool(const char* data, std::size_t n)>& on_bytes) const {
+  int status = 0;
+  std::string error_body;
+  bool stopped = false;
+  auto c = make_client(origin_, token_, 30);  // a stream repeats its last frame every second
+  auto r = c->Get(
+      prefix_ + path, httplib::Headers{},
+      [&](const httplib::Response& res) {
+        status = res.status;
+        if (content_type != nullptr) *content_type = res.get_header_value("Content-Type");
+        return true;
+      },
+      [&](const char* data, std::size_t n) {
+        if (status >= 400) {
+          if (error_body.size() < (1 << 16)) error_body.append(data, n);
+          return true;
+        }
+        stopped = !on_bytes(data, n);
         return !stopped;
       });
   if (stopped) return;

@@ -6,6 +6,7 @@
 // mount: "http://host/levelset"); paths given to the calls start with "/api/v1/...".
 #pragma once
 
+#include <atomic>
 #include <cstdint>
 #include <functional>
 #include <string>
@@ -23,9 +24,10 @@ class Api {
   const std::string& server() const { return server_; }
 
   nlohmann::json get(const std::string& path) const;
-  // POST / PATCH a JSON body; `status` (when given) receives the HTTP status (201 vs 202).
+  // POST / PATCH / PUT a JSON body; `status` (when given) receives the HTTP status (201 vs 202).
   nlohmann::json post(const std::string& path, const nlohmann::json& body, int* status = nullptr) const;
   nlohmann::json patch(const std::string& path, const nlohmann::json& body) const;
+  nlohmann::json put(const std::string& path, const nlohmann::json& body) const;
   nlohmann::json del(const std::string& path) const;  // null for 204
 
   // POST /api/v1/uploads?format=FORMAT with the file streamed as the raw body (with its
@@ -40,8 +42,22 @@ class Api {
   // each event (return false to stop). Returns normally when the stream ends or on_event stopped
   // it; throws ClientError{Server} for a refusal and ClientError{Connect} when the connection
   // could not be made or broke (the caller resumes with the last id it saw).
+  // `stop` (optional) is checked on every chunk (the server's keep-alives come each second), so
+  // another thread can end a stream that has no events to deliver.
   void events(const std::string& path, const std::string& last_event_id,
-              const std::function<bool(const SseEvent&)>& on_event) const;
+              const std::function<bool(const SseEvent&)>& on_event, const std::atomic<bool>* stop = nullptr) const;
+
+  // A GET whose body is kept as bytes (meshes, bands, frames). With `etag` set it is sent as
+  // If-None-Match: a 304 answer has status 304 and an empty body. Errors as get().
+  struct Raw {
+    int status = 0;
+    std::string body, etag, content_type;
+  };
+  Raw get_raw(const std::string& path, const std::string& etag = "") const;
+  // A GET streamed to on_bytes as it arrives (the MJPEG stream); on_bytes returns false to end
+  // it. `content_type` receives the answer's type before the first bytes. Errors as events().
+  void get_stream(const std::string& path, std::string* content_type,
+                  const std::function<bool(const char* data, std::size_t n)>& on_bytes) const;
 
   static std::string encode(const std::string& text);  // percent-encoding for a path or query part
 

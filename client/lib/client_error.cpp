@@ -34,8 +34,10 @@ ClientError ClientError::from_response(int status, const std::string& body) {
   const json j = json::parse(body, nullptr, false);
   if (j.is_object() && j.contains("error") && j["error"].is_object()) {
     const json& e = j["error"];
-    return ClientError(Kind::Server, one_line(e.value("code", "http_" + std::to_string(status))),
-                       one_line(e.value("message", "HTTP " + std::to_string(status))), status);
+    ClientError error(Kind::Server, one_line(e.value("code", "http_" + std::to_string(status))),
+                      one_line(e.value("message", "HTTP " + std::to_string(status))), status);
+    if (e.contains("details") && e["details"].is_object()) error.details_ = e["details"];
+    return error;
   }
   std::string text = one_line(body, 200);
   if (text.empty()) text = "HTTP " + std::to_string(status);

@@ -22,6 +22,8 @@ class ClientError : public std::runtime_error {
   const std::string& code() const { return code_; }
   const std::string& message() const { return message_; }
   int status() const { return status_; }
+  // The server's "details" object when it sent one (a formula error's field and column), else null.
+  const nlohmann::json& details() const { return details_; }
   int exit_code() const;  // Server 1, Usage 2, Connect 3, Local 4
 
   // From an HTTP error response: the server's JSON error, or "http_STATUS" and the body's start.
@@ -33,6 +35,7 @@ class ClientError : public std::runtime_error {
   Kind kind_;
   std::string code_, message_;
   int status_;
+  nlohmann::json details_;
 };
 
 }  // namespace levelset::client

@@ -39,8 +39,9 @@ json follow_job(const Api& api, const std::string& job_id, const FollowCallbacks
           done = true;
         }
         return true;
-      });
+      }, cb.stop);
       failing_since = -1;
+      if (cb.stop != nullptr && cb.stop->load()) return nullptr;
     } catch (const ClientError& e) {
       if (e.kind() != ClientError::Kind::Connect) throw;
       if (received) failing_since = -1;
@@ -53,6 +54,7 @@ json follow_job(const Api& api, const std::string& job_id, const FollowCallbacks
       if (cb.on_notice) cb.on_notice("connection lost (" + e.message() + "); resuming after event " +
                                      last_id);
       std::this_thread::sleep_for(std::chrono::milliseconds(std::min(2000, 100 << std::min(attempt, 4))));
+      if (cb.stop != nullptr && cb.stop->load()) return nullptr;
       continue;
     }
     // The stream ended: normally after the job's end; otherwise (a server restart reset the

@@ -6,6 +6,7 @@
 // once. The caller decides what a final state means (succeeded or not).
 #pragma once
 
+#include <atomic>
 #include <functional>
 #include <string>
 
@@ -20,6 +21,9 @@ struct FollowCallbacks {
   std::function<void(const nlohmann::json& progress)> on_progress;  // "progress" events and the state's
   std::function<void(const std::string& message)> on_notice;        // reconnects
   double reconnect_seconds = 60;
+  // Set by another thread to end the follow early (checked at every chunk, keep-alives included,
+  // so within about a second); follow_job then returns null.
+  const std::atomic<bool>* stop = nullptr;
 };
 
 bool job_ended(const std::string& state);  // succeeded failed cancelled interrupted

@@ -1,0 +1,83 @@
+// What is drawn over the scene and the panel frame: the connection banner, the newest errors,
+// the status line (session, version, view mode, triangles, frame rate), and the panel window
+// holding the tabs.
+#include <cstdio>
+
+#include "panels.hpp"
+
+namespace levelset::gui {
+
+void draw_view_controls(PanelContext& c) {
+  PanelState& p = c.s.panel;
+  ImGui::Text("View mode");
+  ui::radio("auto", &p.view_mode, 0);
+  ImGui::SameLine();
+  ui::radio("local geometry", &p.view_mode, 1);
+  ImGui::SameLine();
+  ui::radio("remote frames", &p.view_mode, 2);
+  ImGui::InputInt("triangle budget", &p.triangle_budget, 10000, 100000);
+  p.triangle_budget = std::max(1, p.triangle_budget);
+  ImGui::Separator();
+  ImGui::Text("Slice and volume (the band)");
+  ImGui::Combo("slice", &p.slice, "none\0x\0y\0z\0");
+  ImGui::SliderFloat("slice position", &p.slice_position, 0.0f, 1.0f);
+  ui::checkbox("volume rendering", &p.volume);
+  ImGui::Separator();
+  ImGui::TextWrapped("Camera: drag to orbit, wheel or +/- to zoom, arrows turn 5 degrees, Home resets; 1-5 pick "
+                     "the shading (A).");
+}
+
+void draw_panel(PanelContext& c, float height) {
+  ImGui::SetNextWindowPos(ImVec2(0, 0));
+  ImGui::SetNextWindowSize(ImVec2(kPanelWidth, height));
+  ImGui::Begin("levelset", nullptr, ImGuiWindowFlags_NoMove | ImGuiWindowFlags_NoResize | ImGuiWindowFlags_NoCollapse);
+  if (ImGui::BeginTabBar("tabs")) {
+    if (ImGui::BeginTabItem("Controls")) {
+      draw_thesis_controls(c);
+      ImGui::EndTabItem();
+    }
+    if (ImGui::BeginTabItem("Sessions")) {
+      draw_server_and_sessions(c);
+      ImGui::EndTabItem();
+    }
+    if (ImGui::BeginTabItem("Jobs")) {
+      draw_jobs_and_log(c);
+      ImGui::EndTabItem();
+    }
+    if (ImGui::BeginTabItem("View")) {
+      draw_view_controls(c);
+      ImGui::EndTabItem();
+    }
+    ImGui::EndTabBar();
+  }
+  ImGui::End();
+}
+
+void draw_overlay(const AppState& s, float scene_x, float width) {
+  ImGui::SetNextWindowPos(ImVec2(scene_x + 8, 8));
+  ImGui::SetNextWindowBgAlpha(0.55f);
+  ImGui::Begin("##overlay", nullptr,
+               ImGuiWindowFlags_NoDecoration | ImGuiWindowFlags_NoInputs | ImGuiWindowFlags_NoFocusOnAppearing |
+                   ImGuiWindowFlags_NoNav | ImGuiWindowFlags_AlwaysAutoResize);
+  ImGui::PushTextWrapPos(ImGui::GetCursorPosX() + width - 40);
+  if (!s.banner.empty()) {
+    ImGui::PushStyleColor(ImGuiCol_Text, ImVec4(1, 0.3f, 0.25f, 1));
+    ImGui::TextWrapped("%s", s.banner.c_str());
+    ImGui::PopStyleColor();
+  }
+  const std::size_t first = s.errors.size() > 3 ? s.errors.size() - 3 : 0;
+  for (std::size_t i = first; i < s.errors.size(); ++i) {
+    ImGui::PushStyleColor(ImGuiCol_Text, ImVec4(1, 0.75f, 0.3f, 1));
+    ImGui::TextWrapped("%s", s.errors[i].c_str());
+    ImGui::PopStyleColor();
+  }
+  char status[256];
+  std::snprintf(status, sizeof status, "%s  version %d  |  %s  |  %llu triangles  |  %.0f fps",
+                s.current.empty() ? "no session" : s.current.c_str(), s.version(),
+                s.remote ? "remote frames" : "local geometry", static_cast<unsigned long long>(s.mesh_triangles), s.fps);
+  ImGui::TextUnformatted(status);
+  ImGui::PopTextWrapPos();
+  ImGui::End();
+}
+
+}  // namespace levelset::gui

@@ -1,0 +1,102 @@
+#include "view_loader.hpp"
+
+#include <cstdio>
+
+#include "grid/lsg_file.hpp"
+#include "io/mesh_reader.hpp"
+
+namespace levelset::gui {
+
+using nlohmann::json;
+using client::Api;
+
+std::uint64_t estimated_triangles(const json& session) {
+  if (!session.is_object() || !session.contains("band") || !session["band"].is_object()) return 0;
+  const json& b = session["band"];
+  const double voxels = b.value("active_voxels", 0.0), half_width = std::max(1.0, b.value("half_width_voxels", 3.0));
+  return std::uint64_t(voxels / half_width);
+}
+
+void ViewLoader::update(AppState& s, int w, int h) {
+  const PanelState& p = s.panel;
+  const std::uint64_t budget = std::uint64_t(std::max(1, p.triangle_budget));
+  s.remote = p.view_mode == 2 ||
+             (p.view_mode == 0 && !s.current.empty() && (estimated_triangles(s.session) > budget || s.mesh_triangles > budget));
+  remote_.show(s.remote && s.connected ? s.current : "", w, h);
+  if (s.current != session_ && !s.current.empty()) {
+    // Another session: drop the old one's geometry (a mesh file previewed before B stays until then).
+    local_.clear();
+    session_ = s.current;
+    s.mesh_triangles = 0;
+    s.mesh_version = -1;
+    mesh_key_.clear();
+    band_key_.clear();
+    etag_.clear();
+  }
+  if (s.remote || s.current.empty() || s.version() <= 0 || !s.connected) return;
+  char iso[32];
+  std::snprintf(iso, sizeof iso, "%.6g", double(s.iso_shown));
+  const std::string key = s.current + "@" + std::to_string(s.version()) + "@" + iso;
+  if (key != mesh_key_) {
+    mesh_key_ = key;
+    fetch_mesh(s);
+  }
+  const bool overlays = p.field != 0 || p.slice != 0 || p.volume;
+  const std::string band_key = s.current + "@" + std::to_string(s.version());
+  if (overlays && band_key != band_key_) {
+    band_key_ = band_key;
+    fetch_band(s);
+  }
+}
+
+void ViewLoader::fetch_mesh(AppState& s) {
+  auto api = api_.get();
+  if (!api) return;
+  char iso[32];
+  std::snprintf(iso, sizeof iso, "%.9g", double(s.iso_shown));
+  const std::string path = "/api/v1/sessions/" + Api::encode(s.current) + "/mesh?format=ply&iso=" + iso;
+  const std::string session = s.current, etag = etag_;
+  const int version = s.version();
+  fetches_.post([this, api, path, session, etag, version] {
+    try {
+      Api::Raw raw = api->get_raw(path, etag);
+      if (raw.status == 304) {
+        inbox_.post([session, version](AppState& st) {
+          if (st.current == session) st.mesh_version = version;
+        });
+        return;
+      }
+      auto mesh = std::make_shared<TriangleMesh>(read_mesh_from_memory(raw.body, "mesh.ply").mesh);
+      inbox_.post([this, session, version, mesh, tag = raw.etag](AppState& st) {
+        if (st.current != session) return;
+        etag_ = tag;
+        st.mesh_triangles = mesh->triangles.size();
+        st.mesh_version = version;
+        local_.set_mesh(std::move(*mesh));
+      });
+    } catch (const std::exception& e) {
+      inbox_.post([session, why = describe_error(e)](AppState& st) {
+        if (st.current == session) st.add_error("surface of " + session + ": " + why);
+      });
+    }
+  });
+}
+
+void ViewLoader::fetch_band(AppState& s) {
+  auto api = api_.get();
+  if (!api) return;
+  const std::string session = s.current;
+  fetches_.post([this, api, session] {
+    try {
+      Api::Raw raw = api->get_raw("/api/v1/sessions/" + Api::encode(session) + "/band");
+      auto band = std::make_shared<const NarrowBand>(decode_lsg(raw.body, "band.lsg").band);
+      inbox_.post([this, session, band](AppState& st) {
+        if (st.current == session) local_.set_band(band);
+      });
+    } catch (const std::exception& e) {
+      inbox_.post([session, why = describe_error(e)](AppState& st) { st.add_error("band of " + session + ": " + why); });
+    }
+  });
+}
+
+}  // namespace levelset::gui

@@ -1,0 +1,43 @@
+// ViewLoader: picks the view mode and keeps it fed. Local geometry: the surface of the shown
+// session version at the iso value (F) is fetched as PLY with its ETag (a 304 costs nothing),
+// and the band (.lsg) when an overlay needs it. Remote frames: the session's MJPEG stream.
+// "auto" switches to remote frames above the triangle budget, judged before downloading from
+// the band's size (active voxels / band half-width ~ surface triangles) and after it from the
+// mesh itself.
+#pragma once
+
+#include <cstdint>
+#include <string>
+
+#include "app_state.hpp"
+#include "net_worker.hpp"
+#include "remote_view.hpp"
+#include "scene_view.hpp"
+
+namespace levelset::gui {
+
+std::uint64_t estimated_triangles(const nlohmann::json& session);
+
+class ViewLoader {
+ public:
+  ViewLoader(const ApiHolder& api, Inbox& inbox, Worker& fetches, SceneView& local, RemoteView& remote)
+      : api_(api), inbox_(inbox), fetches_(fetches), local_(local), remote_(remote) {}
+
+  // UI thread, once a frame; w x h is the scene's size in pixels.
+  void update(AppState& s, int w, int h);
+  void refetch() { mesh_key_.clear(), band_key_.clear(); }
+
+ private:
+  void fetch_mesh(AppState& s);
+  void fetch_band(AppState& s);
+  const ApiHolder& api_;
+  Inbox& inbox_;
+  Worker& fetches_;
+  SceneView& local_;
+  RemoteView& remote_;
+  std::string session_;            // the session the local scene belongs to
+  std::string mesh_key_, band_key_;  // what was last asked for: session@version@iso
+  std::string etag_;
+};
+
+}  // namespace levelset::gui

@@ -1,0 +1,282 @@
+#!/usr/bin/python3
+"""levelset-gui under Xvfb against a real levelsetd (run under `xvfb-run -a`, 24-bit screen).
+
+Usage: gui_client.py LEVELSET_GUI LEVELSETD SCRATCH CGAL_DATA SCENARIO
+
+Scenarios (each drives the window with --script: the functions the buttons call and injected
+ImGui mouse / keyboard input; the window's state comes back as JSON dumps):
+  workflow   connect to a daemon, load CGAL's knot.off (C), compute its distance field (B), type
+             a formula into the formula box and press Evolve (G) through injected input, extract
+             and shade the isosurface (F, A), save the mesh (C), screenshot (K): the image shows
+             the panel and a shaded, non-empty surface; the daemon's session holds the evolved
+             version; a bad formula shows the server's error with its column under the box.
+  reconnect  a killed daemon shows the banner; the daemon restarted on the same port clears it.
+  embedded   no --server: the window starts its own `levelsetd serve --port 0` and stops it on
+             exit, by its script's quit and on SIGTERM (no process left behind); the settings
+             file keeps the panel between runs.
+Missing tools (PIL, the binaries, the knot) fail the test; nothing is skipped.
+"""
+import json
+import os
+import shutil
+import signal
+import socket
+import subprocess
+import sys
+import time
+
+from PIL import Image  # python3-pil; missing: the test fails here
+
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "integration"))
+from daemon_harness import Daemon  # noqa: E402
+
+GUI, LEVELSETD, SCRATCH, CGAL, SCENARIO = sys.argv[1:6]
+KNOT = os.path.join(CGAL, "meshes", "knot.off")
+PANEL_WIDTH = 420  # client/gui/panels.hpp kPanelWidth
+WIDTH, HEIGHT = 1280, 900
+BACKGROUND = (0.13, 0.13, 0.2)  # render::ViewSettings' default background
+
+
+def check(cond, what):
+    if not cond:
+        raise AssertionError(what)
+
+
+def wait_until(pred, what, timeout=60):
+    deadline = time.monotonic() + timeout
+    while time.monotonic() < deadline:
+        value = pred()
+        if value:
+            return value
+        time.sleep(0.05)
+    raise AssertionError("timed out waiting for " + what)
+
+
+def gui_env(name):
+    env = dict(os.environ)
+    env["XDG_CONFIG_HOME"] = os.path.join(SCRATCH, name, "config")
+    env["XDG_STATE_HOME"] = os.path.join(SCRATCH, name, "state")
+    return env
+
+
+def start_gui(name, script_lines, *args):
+    """Starts the window with a script; returns (process, directory)."""
+    d = os.path.join(SCRATCH, name)
+    os.makedirs(d, exist_ok=True)
+    script = os.path.join(d, "script.txt")
+    with open(script, "w") as f:
+        f.write("\n".join(script_lines) + "\n")
+    log = open(os.path.join(d, "gui.log"), "wb")
+    cmd = [GUI, "--script", script, "--width", str(WIDTH), "--height", str(HEIGHT),
+           "--dump-state", os.path.join(d, "final.json"), *args]
+    return subprocess.Popen(cmd, stdout=log, stderr=subprocess.STDOUT, env=gui_env(name)), d
+
+
+def finish_gui(proc, d, timeout=180):
+    rc = proc.wait(timeout=timeout)
+    with open(os.path.join(d, "gui.log"), "rb") as f:
+        log = f.read().decode("utf-8", "replace")
+    check(rc == 0, f"levelset-gui exited {rc}; its log ends:\n{log[-3000:]}")
+    return log
+
+
+def load_json(path):
+    with open(path) as f:
+        return json.load(f)
+
+
+def image_stats(path):
+    """Panel: many distinct grey levels (text on the panel). Scene: pixels off the background,
+    their brightness spread (shading) and warm hue (the surface colour)."""
+    img = Image.open(path).convert("RGB")
+    check(img.size == (WIDTH, HEIGHT), f"{path}: size {img.size}")
+    px = img.load()
+    panel = [px[x, y] for x in range(0, PANEL_WIDTH, 3) for y in range(0, HEIGHT, 3)]
+    bg = tuple(round(c * 255) for c in BACKGROUND)
+    scene = [px[x, y] for x in range(PANEL_WIDTH, WIDTH, 3) for y in range(60, HEIGHT, 3)]
+    surface = [p for p in scene if abs(p[0] - bg[0]) + abs(p[1] - bg[1]) + abs(p[2] - bg[2]) > 60 and p[0] > p[2]]
+    lum = sorted(0.3 * p[0] + 0.59 * p[1] + 0.11 * p[2] for p in surface) or [0]
+    return {"panel_levels": len(set(panel)), "panel_bright": sum(1 for p in panel if sum(p) > 450),
+            "surface_fraction": len(surface) / len(scene),
+            "lum_spread": lum[int(0.95 * (len(lum) - 1))] - lum[int(0.05 * (len(lum) - 1))]}
+
+
+def red_pixels(path, box):
+    img = Image.open(path).convert("RGB")
+    px = img.load()
+    x0, y0, x1, y1 = (int(v) for v in box)
+    return sum(1 for x in range(x0, x1) for y in range(y0, y1)
+               if px[x, y][0] > 180 and px[x, y][1] < 140 and px[x, y][2] < 140)
+
+
+def scenario_workflow():
+    check(os.path.isfile(KNOT), "no knot.off at " + KNOT)
+    daemon = Daemon(LEVELSETD, os.path.join(SCRATCH, "data"))
+    try:
+        workflow_with(daemon)
+    finally:
+        daemon.stop()
+
+
+def workflow_with(daemon):
+    d = os.path.join(SCRATCH, "workflow")
+    saved = os.path.join(d, "surface.ply")
+    formula, bad = "-0.5*H", "-H + sin(x) * * 2"
+    script = [
+        "wait_connected 30", f"set mesh_file {KNOT}", "press load_mesh", "wait_idle 60",
+        "set resolution 64", "set band 3", "click 'Compute distance field'", "wait_session 120", "wait_idle 120",
+        "wait_surface 60",
+        # G: typed into the box through injected input, started by clicking Evolve.
+        "click ##formula", "key ctrl+a", f"type '{formula}'", "set steps 10", "click Evolve", "frames 2",
+        "wait_idle 120", "expect_no_errors",
+        "set iso 0", "press extract", "click smooth", "wait_surface 60", "frames 5",
+        f"set save_file {saved}", "press save_mesh", "wait_idle 60",
+        f"screenshot {d}/surface.png", f"dump {d}/after_evolve.json",
+        "click ##formula", "key ctrl+a", f"type '{bad}'", "click Evolve", "wait_formula_error 30", "frames 2",
+        f"screenshot {d}/formula_error.png", f"dump {d}/formula_error.json",
+    ]
+    t0 = time.monotonic()
+    proc, d = start_gui("workflow", script, "--server", daemon.url)
+    finish_gui(proc, d)
+    print(f"workflow script ran in {time.monotonic() - t0:.1f} s")
+    state = load_json(os.path.join(d, "after_evolve.json"))
+    check(state["connected"] and not state["errors"], f"errors after evolving: {state['errors']}")
+    sid = state["session"]
+    check(sid and state["version"] >= 2, f"no evolved session: {state['session']} v{state['version']}")
+    ops = [j["op"] for j in state["jobs"] if j["mine"] and j["state"] == "succeeded"]
+    check("cpt" in ops and "evolve" in ops, f"jobs: {state['jobs']}")
+    status, _, session = daemon.get(f"/api/v1/sessions/{sid}")
+    check(status == 200 and session["version"] == state["version"], f"daemon's session: {session}")
+    status, _, history = daemon.get(f"/api/v1/sessions/{sid}/history")
+    check(formula in json.dumps(history), f"the typed formula is not in the session's history: {history}")
+    check(state["view"]["mesh_version"] == state["version"] and state["view"]["triangles"] > 1000,
+          f"the local view does not show the evolved surface: {state['view']}")
+    status, _, mesh = daemon.request("GET", f"/api/v1/sessions/{sid}/mesh?iso=0&format=ply")
+    with open(saved, "rb") as f:
+        check(f.read() == mesh, "the saved mesh differs from the daemon's")
+    stats = image_stats(os.path.join(d, "surface.png"))
+    print("surface.png", stats)
+    check(stats["panel_levels"] >= 8 and stats["panel_bright"] > 200, f"no panel drawn: {stats}")
+    check(stats["surface_fraction"] > 0.05, f"no surface in the scene: {stats}")
+    check(stats["lum_spread"] > 40, f"the surface is not shaded: {stats}")
+    err = load_json(os.path.join(d, "formula_error.json"))
+    fe = err["formula_error"]
+    check(fe["formula"] == bad and fe["column"] == bad.index("* *") + 3, f"formula error: {fe}")
+    check(any("expected a value" in e for e in err["errors"]), f"error text: {err['errors']}")
+    box = err["widgets"]["##formula"]
+    # The caret and message in red just under the box, the caret at the column's x.
+    char_w = (box[2] - box[0]) / max(1, (box[2] - box[0]) // 7)
+    caret_x = box[0] + 4 + (fe["column"] - 1) * 7
+    under = (caret_x - 2, box[3], caret_x + 9, box[3] + 16)
+    check(red_pixels(os.path.join(d, "formula_error.png"), under) > 3, f"no caret under column {fe['column']}")
+    check(red_pixels(os.path.join(d, "formula_error.png"), (box[0], box[3] + 14, box[2], box[3] + 34)) > 30,
+          "no error message under the formula box")
+    del char_w
+
+
+def free_port():
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
+def scenario_reconnect():
+    port = free_port()
+    data = os.path.join(SCRATCH, "data")
+    daemon = Daemon(LEVELSETD, data, port=port)
+    d = os.path.join(SCRATCH, "reconnect")
+    script = ["wait_connected 30", "set primitive sphere", "set resolution 32", "press create_primitive",
+              "wait_session 60", "wait_surface 60", f"dump {d}/connected.json",
+              "wait_disconnected 60", "frames 3", f"screenshot {d}/banner.png", f"dump {d}/banner.json",
+              "wait_connected 60", "wait_surface 60", "frames 3", f"screenshot {d}/reconnected.png",
+              f"dump {d}/reconnected.json"]
+    proc, d = start_gui("reconnect", script, "--server", daemon.url)
+    try:
+        wait_until(lambda: os.path.exists(os.path.join(d, "connected.json")), "the first dump", 120)
+        daemon.kill()  # SIGKILL: the connection breaks with no goodbye
+        wait_until(lambda: os.path.exists(os.path.join(d, "banner.json")), "the banner", 90)
+        daemon = Daemon(LEVELSETD, data, port=port)
+        finish_gui(proc, d)
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+        daemon.stop()
+    banner = load_json(os.path.join(d, "banner.json"))
+    check(not banner["connected"] and "Connection lost" in banner["banner"], f"banner: {banner['banner']!r}")
+    shown = red_pixels(os.path.join(d, "banner.png"), (PANEL_WIDTH, 0, WIDTH, 60))
+    check(shown > 100, f"no red banner over the scene ({shown} red pixels)")
+    after = load_json(os.path.join(d, "reconnected.json"))
+    check(after["connected"] and after["banner"] == "", f"banner after the restart: {after['banner']!r}")
+    check(red_pixels(os.path.join(d, "reconnected.png"), (PANEL_WIDTH, 0, WIDTH, 60)) < 20, "the banner stayed")
+    check(after["session"] == banner["session"] and after["version"] >= 1, "the session did not come back")
+
+
+def process_alive(pid):
+    try:
+        with open(f"/proc/{pid}/stat") as f:
+            return f.read().split(")")[-1].split()[0] != "Z"
+    except FileNotFoundError:
+        return False
+
+
+def children_of(pid):
+    out = []
+    for entry in os.listdir("/proc"):
+        if entry.isdigit():
+            try:
+                with open(f"/proc/{entry}/stat") as f:
+                    if int(f.read().split(")")[-1].split()[1]) == pid:
+                        out.append(int(entry))
+            except (FileNotFoundError, ProcessLookupError, IndexError):
+                pass
+    return out
+
+
+def scenario_embedded():
+    # Run 1: the script quits; the panel's formula is remembered.
+    script = ["wait_connected 60", "set formula '0.25 - H'", "set primitive torus", "set resolution 32",
+              "press create_primitive", "wait_session 60", "wait_surface 60", f"dump {SCRATCH}/embedded/run1.json"]
+    proc, d = start_gui("embedded", script)
+    pid = wait_until(lambda: load_json(os.path.join(d, "run1.json"))["daemon_pid"]
+                     if os.path.exists(os.path.join(d, "run1.json")) else 0, "the first dump", 120)
+    check(process_alive(pid) and pid in children_of(proc.pid), f"levelsetd {pid} is not the window's child")
+    with open(f"/proc/{pid}/cmdline", "rb") as f:
+        check(b"levelsetd\0serve\0--port\x000" in f.read(), "not `levelsetd serve --port 0`")
+    run1 = load_json(os.path.join(d, "run1.json"))
+    finish_gui(proc, d)
+    check(not process_alive(pid), f"levelsetd {pid} outlived the window")
+    port = int(run1["server"].rsplit(":", 1)[1])
+    with socket.socket() as s:
+        check(s.connect_ex(("127.0.0.1", port)) != 0, "the embedded daemon's port still answers")
+    settings = load_json(os.path.join(SCRATCH, "embedded", "config", "levelset", "gui.json"))
+    check(settings["panel"]["formula"] == "0.25 - H" and settings["server"] == "", f"settings: {settings}")
+
+    # Run 2: the settings come back; SIGTERM to the window also stops its daemon.
+    script = ["wait_connected 60", f"dump {SCRATCH}/embedded/run2.json", "frames 100000000"]
+    proc, d = start_gui("embedded", script)
+    path = os.path.join(d, "run2.json")
+    wait_until(lambda: os.path.exists(path), "the second dump", 120)
+    run2 = load_json(path)
+    check(run2["panel"]["formula"] == "0.25 - H", f"the formula was not remembered: {run2['panel']['formula']}")
+    check(run2["panel"]["primitive"] == "torus", "the primitive was not remembered")
+    pid2 = run2["daemon_pid"]
+    check(process_alive(pid2), "no second embedded daemon")
+    proc.send_signal(signal.SIGTERM)
+    rc = proc.wait(timeout=60)
+    check(rc == 0, f"SIGTERM: the window exited {rc}")
+    check(not process_alive(pid2), f"levelsetd {pid2} outlived the window's SIGTERM")
+
+
+def main():
+    for tool in (GUI, LEVELSETD):
+        check(os.access(tool, os.X_OK), f"missing {tool}")
+    check(os.environ.get("DISPLAY"), "no DISPLAY: run under xvfb-run -a")
+    shutil.rmtree(SCRATCH, ignore_errors=True)
+    os.makedirs(SCRATCH)
+    t0 = time.monotonic()
+    {"workflow": scenario_workflow, "reconnect": scenario_reconnect, "embedded": scenario_embedded}[SCENARIO]()
+    print(f"gui {SCENARIO}: ok in {time.monotonic() - t0:.1f} s")
+
+
+if __name__ == "__main__":
+    main()
