@@ -71,10 +71,11 @@ void draw_overlay(const AppState& s, float scene_x, float width) {
     ImGui::TextWrapped("%s", s.errors[i].c_str());
     ImGui::PopStyleColor();
   }
-  char status[256];
-  std::snprintf(status, sizeof status, "%s  version %d  |  %s  |  %llu triangles  |  %.0f fps",
+  char status[256], fps[32] = "-- fps";  // measured over the first second
+  if (s.fps > 0) std::snprintf(fps, sizeof fps, "%.0f fps", s.fps);
+  std::snprintf(status, sizeof status, "%s  version %d  |  %s  |  %llu triangles  |  %s",
                 s.current.empty() ? "no session" : s.current.c_str(), s.version(),
-                s.remote ? "remote frames" : "local geometry", static_cast<unsigned long long>(s.mesh_triangles), s.fps);
+                s.remote ? "remote frames" : "local geometry", static_cast<unsigned long long>(s.mesh_triangles), fps);
   ImGui::TextUnformatted(status);
   ImGui::PopTextWrapPos();
   ImGui::End();

@@ -49,7 +49,7 @@ std::vector<std::string> split_words(const std::string& text, int number) {
 const std::map<std::string, int>& known_commands() {  // name -> the fewest words after it
   static const std::map<std::string, int> m = {
       {"connect", 1}, {"set", 2}, {"press", 1}, {"click", 1}, {"type", 1}, {"key", 1}, {"camera", 3}, {"select", 1},
-      {"wait_connected", 0}, {"wait_disconnected", 0}, {"wait_session", 0}, {"wait_idle", 0}, {"wait_surface", 0},
+      {"wait_connected", 0}, {"wait_disconnected", 0}, {"wait_session", 0}, {"wait_idle", 0}, {"wait_surface", 0}, {"wait_running", 0},
       {"wait_error", 1}, {"wait_formula_error", 0}, {"frames", 1}, {"screenshot", 1}, {"dump", 1},
       {"expect_no_errors", 0}, {"clear_errors", 0}, {"quit", 0}};
   return m;
@@ -117,6 +117,13 @@ ScriptRunner::Step ScriptRunner::wait_for(bool condition, const Line& line, cons
   return Step::Wait;
 }
 
+ScriptRunner::Step ScriptRunner::settle(bool condition, const Line& line, const std::string& what) {
+  held_ = condition ? held_ + 1 : 0;
+  const Step step = wait_for(held_ >= 3, line, what);
+  if (step != Step::Wait) held_ = 0;
+  return step;
+}
+
 ScriptRunner::Step ScriptRunner::click(const Line& line, App& app) {
   if (click_phase_ == 0) {
     const WidgetRect* r = app.widgets().find(line.words[1]);
@@ -143,6 +150,13 @@ ScriptRunner::Step ScriptRunner::press(const std::string& action, App& app) {
       {"reconstruct", &Actions::reconstruct}, {"screenshot", &Actions::request_screenshot},
       {"quit", &Actions::quit},               {"create_primitive", &Actions::create_primitive},
       {"snapshot", &Actions::snapshot},       {"run_job_file", &Actions::run_job_file}};
+  if (action == "rename") return a.rename_session(), Step::Done;
+  if (action == "delete") return a.delete_session(app.state().current), Step::Done;
+  if (action == "restore") {
+    const json& snaps = app.state().snapshots;
+    if (snaps.empty()) return Step::Fail;
+    return a.restore(snaps.back().value("id", "")), Step::Done;
+  }
   auto it = table.find(action);
   if (it == table.end()) return Step::Fail;
   (a.*(it->second))();
@@ -190,7 +204,7 @@ ScriptRunner::Step ScriptRunner::run(const Line& line, App& app) {
   }
   if (cmd == "press") {
     if (press(arg(1), app) == Step::Done) return Step::Done;
-    fail(line, "unknown action '" + arg(1) + "'");
+    fail(line, "unknown action '" + arg(1) + "' (or nothing to act on)");
     return Step::Fail;
   }
   if (cmd == "click") return click(line, app);
@@ -243,11 +257,16 @@ ScriptRunner::Step ScriptRunner::run_wait(const Line& line, App& app) {
   if (cmd == "wait_disconnected") return wait_for(!s.banner.empty(), line, "the connection-lost banner");
   if (cmd == "wait_session") return wait_for(!s.current.empty() && s.version() > 0, line, "a session");
   if (cmd == "wait_idle")
-    return wait_for(app.network_idle() && !s.job_running() && s.select_after_job.empty(), line, "the jobs to end");
+    return settle(app.network_idle() && !s.job_running() && s.select_after_job.empty(), line, "the jobs to end");
+  if (cmd == "wait_running") {
+    bool running = false;
+    for (const JobRow& j : s.jobs) running = running || (j.mine && j.state == "running");
+    return wait_for(running, line, "a running job");
+  }
   if (cmd == "wait_surface") {
     const bool shown = s.remote ? s.frames_received > 0
                                 : s.mesh_version == s.version() && s.mesh_triangles > 0 && app.network_idle();
-    return wait_for(!s.current.empty() && shown, line, "the surface of the session's version");
+    return settle(!s.current.empty() && shown, line, "the surface of the session's version");
   }
   if (cmd == "wait_error") {
     bool found = false;

@@ -6,12 +6,13 @@
 //   connect URL [TOKEN]          set FIELD VALUE (a panel field, settings_store.cpp's names)
 //   press ACTION                 the function a button calls: load_mesh compute_distance
 //       evolve stop redistance extract save_mesh load_points reconstruct screenshot quit
-//       create_primitive snapshot run_job_file
+//       create_primitive rename delete snapshot restore (the newest snapshot) run_job_file
 //   click LABEL                  injected ImGui mouse click at the centre of a labelled control
 //   type TEXT                    injected characters (into the focused text box)
 //   key ctrl+a|enter|backspace   an injected key press
 //   camera YAW PITCH ZOOM        select SESSION_ID
 //   wait_connected / wait_disconnected / wait_session / wait_idle / wait_surface [S]
+//   wait_running [S]             a job of this window runs
 //   wait_error TEXT [S]          an error containing TEXT is shown
 //   wait_formula_error [S]       the formula box shows a server error with its column
 //   frames N                     let N frames pass
@@ -48,6 +49,7 @@ class ScriptRunner {
   Step run(const Line& line, App& app);
   Step run_wait(const Line& line, App& app);
   Step wait_for(bool condition, const Line& line, const std::string& what);
+  Step settle(bool condition, const Line& line, const std::string& what);  // held for 3 frames
   Step click(const Line& line, App& app);
   Step press(const std::string& action, App& app);
   void fail(const Line& line, const std::string& why);
@@ -60,6 +62,7 @@ class ScriptRunner {
   std::chrono::steady_clock::time_point started_;  // of the current command
   bool started_set_ = false;
   std::uint64_t frames_wanted_ = 0;
+  int held_ = 0;  // consecutive frames a settle condition held (results posted late still land)
   // Injected input: a click is move (1 frame), press (1 frame), release.
   int click_phase_ = 0;
   ImVec2 mouse_{-1, -1};

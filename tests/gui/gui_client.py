@@ -9,7 +9,12 @@ ImGui mouse / keyboard input; the window's state comes back as JSON dumps):
              a formula into the formula box and press Evolve (G) through injected input, extract
              and shade the isosurface (F, A), save the mesh (C), screenshot (K): the image shows
              the panel and a shaded, non-empty surface; the daemon's session holds the evolved
-             version; a bad formula shows the server's error with its column under the box.
+             version; above the triangle budget the view switches to the daemon's frames, which
+             follow the panel's shading (PUT view); a bad formula shows the server's error with
+             its column under the box. Writes SCRATCH/levelset-gui.png (the README's picture).
+  sessions   create from a primitive, rename, snapshot, evolve and Stop (the state reached is
+             kept), restore the snapshot, redistance (H), run a job file (its session is shown),
+             delete: each checked on the daemon.
   reconnect  a killed daemon shows the banner; the daemon restarted on the same port clears it.
   embedded   no --server: the window starts its own `levelsetd serve --port 0` and stops it on
              exit, by its script's quit and on SIGTERM (no process left behind); the settings
@@ -32,6 +37,7 @@ from daemon_harness import Daemon  # noqa: E402
 
 GUI, LEVELSETD, SCRATCH, CGAL, SCENARIO = sys.argv[1:6]
 KNOT = os.path.join(CGAL, "meshes", "knot.off")
+JOB_FILE = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "configs", "jobs", "evolve_dumbbell.conf")
 PANEL_WIDTH = 420  # client/gui/panels.hpp kPanelWidth
 WIDTH, HEIGHT = 1280, 900
 BACKGROUND = (0.13, 0.13, 0.2)  # render::ViewSettings' default background
@@ -69,7 +75,7 @@ def start_gui(name, script_lines, *args):
     log = open(os.path.join(d, "gui.log"), "wb")
     cmd = [GUI, "--script", script, "--width", str(WIDTH), "--height", str(HEIGHT),
            "--dump-state", os.path.join(d, "final.json"), *args]
-    return subprocess.Popen(cmd, stdout=log, stderr=subprocess.STDOUT, env=gui_env(name)), d
+    return subprocess.Popen(cmd, stdout=log, stderr=subprocess.STDOUT, env=gui_env(name), cwd=d), d
 
 
 def finish_gui(proc, d, timeout=180):
@@ -120,7 +126,7 @@ def scenario_workflow():
 
 def workflow_with(daemon):
     d = os.path.join(SCRATCH, "workflow")
-    saved = os.path.join(d, "surface.ply")
+    saved = os.path.join(d, "knot-evolved.ply")  # the window runs in d: a relative name there
     formula, bad = "-0.5*H", "-H + sin(x) * * 2"
     script = [
         "wait_connected 30", f"set mesh_file {KNOT}", "press load_mesh", "wait_idle 60",
@@ -129,9 +135,12 @@ def workflow_with(daemon):
         # G: typed into the box through injected input, started by clicking Evolve.
         "click ##formula", "key ctrl+a", f"type '{formula}'", "set steps 10", "click Evolve", "frames 2",
         "wait_idle 120", "expect_no_errors",
-        "set iso 0", "press extract", "click smooth", "wait_surface 60", "frames 5",
-        f"set save_file {saved}", "press save_mesh", "wait_idle 60",
+        "set iso 0", "press extract", "click smooth", "wait_surface 60", "frames 70",
+        "set save_file knot-evolved.ply", "press save_mesh", "wait_idle 60",
         f"screenshot {d}/surface.png", f"dump {d}/after_evolve.json",
+        # Above the triangle budget the view switches to the daemon's frames; A goes through PUT view.
+        "set triangle_budget 1000", "click flat", "frames 2", "wait_surface 60", "frames 30",
+        f"screenshot {d}/remote.png", f"dump {d}/remote.json", "set triangle_budget 2000000",
         "click ##formula", "key ctrl+a", f"type '{bad}'", "click Evolve", "wait_formula_error 30", "frames 2",
         f"screenshot {d}/formula_error.png", f"dump {d}/formula_error.json",
     ]
@@ -159,6 +168,18 @@ def workflow_with(daemon):
     check(stats["panel_levels"] >= 8 and stats["panel_bright"] > 200, f"no panel drawn: {stats}")
     check(stats["surface_fraction"] > 0.05, f"no surface in the scene: {stats}")
     check(stats["lum_spread"] > 40, f"the surface is not shaded: {stats}")
+    # The README's picture (docs/levelset-gui.png is a copy): 64 colours keep it small.
+    Image.open(os.path.join(d, "surface.png")).convert("RGB").quantize(colors=64).save(
+        os.path.join(SCRATCH, "levelset-gui.png"), optimize=True)
+    evolve_jobs = [j for j in state["jobs"] if j["op"] == "evolve"]
+    check(evolve_jobs and evolve_jobs[0]["fraction"] == 1.0, f"the evolve job's progress: {evolve_jobs}")
+    remote = load_json(os.path.join(d, "remote.json"))
+    check(remote["view"]["remote"] and remote["view"]["frames_received"] > 0, f"no remote frames: {remote['view']}")
+    status, _, view = daemon.get(f"/api/v1/sessions/{sid}/view")
+    check(status == 200 and view["shading"] == "flat", f"the panel's shading did not reach the daemon: {view}")
+    stats = image_stats(os.path.join(d, "remote.png"))
+    print("remote.png", stats)
+    check(stats["surface_fraction"] > 0.05 and stats["lum_spread"] > 20, f"no surface in the remote frame: {stats}")
     err = load_json(os.path.join(d, "formula_error.json"))
     fe = err["formula_error"]
     check(fe["formula"] == bad and fe["column"] == bad.index("* *") + 3, f"formula error: {fe}")
@@ -172,6 +193,54 @@ def workflow_with(daemon):
     check(red_pixels(os.path.join(d, "formula_error.png"), (box[0], box[3] + 14, box[2], box[3] + 34)) > 30,
           "no error message under the formula box")
     del char_w
+
+
+def scenario_sessions():
+    daemon = Daemon(LEVELSETD, os.path.join(SCRATCH, "data"))
+    try:
+        sessions_with(daemon)
+    finally:
+        daemon.stop()
+
+
+def sessions_with(daemon):
+    d = os.path.join(SCRATCH, "sessions")
+    script = [
+        "wait_connected 30", "set primitive sphere", "set resolution 32", "press create_primitive", "wait_session 60",
+        "wait_surface 60", "set new_name ball", "press rename", "set snapshot_name before", "press snapshot",
+        "wait_idle 30", f"dump {d}/snapshot.json",
+        # G's Stop: a long evolution ends at a step boundary with the state reached.
+        "set formula -H", "set steps 100000", "press evolve", "wait_running 60", "frames 20", "click Stop",
+        "wait_idle 120", "wait_surface 60", f"dump {d}/stopped.json",
+        "press restore", "wait_idle 30", "wait_surface 60", f"dump {d}/restored.json",
+        "press redistance", "wait_idle 120", "wait_surface 60", f"dump {d}/redistanced.json",
+        f"set job_file {JOB_FILE}", "set_job_overrides", "press run_job_file", "wait_idle 180", "wait_surface 60",
+        f"dump {d}/job_file.json", "press delete", "wait_idle 30", "frames 5", f"dump {d}/deleted.json"]
+    script.remove("set_job_overrides")
+    proc, d = start_gui("sessions", script, "--server", daemon.url)
+    finish_gui(proc, d, timeout=280)
+    snap = load_json(os.path.join(d, "snapshot.json"))
+    sid = snap["session"]
+    _, _, session = daemon.get(f"/api/v1/sessions/{sid}")
+    check(session["name"] == "ball", f"rename: {session['name']}")
+    _, _, snaps = daemon.get(f"/api/v1/sessions/{sid}/snapshots")
+    check([s["name"] for s in snaps["snapshots"]] == ["before"], f"snapshots: {snaps}")
+    stopped = load_json(os.path.join(d, "stopped.json"))
+    job = [j for j in stopped["jobs"] if j["op"] == "evolve"][0]
+    _, _, job = daemon.get(f"/api/v1/jobs/{job['id']}")
+    check(job["state"] == "succeeded" and stopped["version"] == 2, f"stopped job: {job['state']} v{stopped['version']}")
+    evolution = job["result"]["evolution"]
+    check(evolution["stop"] == "stopped" and 0 < evolution["steps"] < 100000, f"not stopped: {evolution}")
+    restored = load_json(os.path.join(d, "restored.json"))
+    check(restored["version"] == 3 and restored["view"]["mesh_version"] == 3, f"restore: {restored['version']}")
+    redist = load_json(os.path.join(d, "redistanced.json"))
+    check(redist["version"] == 4 and not redist["errors"], f"redistance: v{redist['version']} {redist['errors']}")
+    made = load_json(os.path.join(d, "job_file.json"))
+    check(made["session"] and made["session"] != sid and made["view"]["triangles"] > 0, f"job file: {made['session']}")
+    check(any(j["op"] == "job" or j["op"] == "evolve" for j in made["jobs"] if j["mine"]), f"jobs: {made['jobs']}")
+    deleted = load_json(os.path.join(d, "deleted.json"))
+    status, _, _ = daemon.get(f"/api/v1/sessions/{made['session']}")
+    check(status == 404 and deleted["session"] == "", f"delete: {status}, shown {deleted['session']!r}")
 
 
 def free_port():
@@ -274,7 +343,8 @@ def main():
     shutil.rmtree(SCRATCH, ignore_errors=True)
     os.makedirs(SCRATCH)
     t0 = time.monotonic()
-    {"workflow": scenario_workflow, "reconnect": scenario_reconnect, "embedded": scenario_embedded}[SCENARIO]()
+    {"workflow": scenario_workflow, "sessions": scenario_sessions, "reconnect": scenario_reconnect,
+     "embedded": scenario_embedded}[SCENARIO]()
     print(f"gui {SCENARIO}: ok in {time.monotonic() - t0:.1f} s")
 
 
