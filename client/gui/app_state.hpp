@@ -82,6 +82,7 @@ struct AppState {
   std::uint64_t mesh_triangles = 0;
   std::int64_t mesh_version = -1;   // the session version the local mesh shows
   std::uint64_t frames_received = 0;
+  bool band_loaded = false;         // the band of the shown session is here (D's overlays)
   double fps = 0;
   bool quit = false;
   int daemon_pid = 0;               // the embedded levelsetd (0: none)

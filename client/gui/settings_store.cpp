@@ -74,6 +74,7 @@ bool save_settings(const std::string& path, const Settings& s) {
   {
     std::ofstream out(temp, std::ios::trunc);
     if (!out) return false;
+    fs::permissions(temp, fs::perms::owner_read | fs::perms::owner_write, ec);  // it may hold a token
     out << j.dump(2) << "\n";
     if (!out) return false;
   }

@@ -1,7 +1,8 @@
 // Settings remembered between runs: the server and token, the window's size and the panel's
 // values, as a small JSON file: $XDG_CONFIG_HOME/levelset/gui.json (~/.config/... without it).
 // A missing or unreadable file gives the defaults; unknown keys are ignored, so files from other
-// versions load. Written atomically (temp + rename) on exit.
+// versions load. Written atomically (temp + rename) on exit, readable by its owner only (the
+// token).
 #pragma once
 
 #include <string>

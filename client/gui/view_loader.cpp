@@ -29,6 +29,7 @@ void ViewLoader::update(AppState& s, int w, int h) {
     session_ = s.current;
     s.mesh_triangles = 0;
     s.mesh_version = -1;
+    s.band_loaded = false;
     mesh_key_.clear();
     band_key_.clear();
     etag_.clear();
@@ -91,7 +92,9 @@ void ViewLoader::fetch_band(AppState& s) {
       Api::Raw raw = api->get_raw("/api/v1/sessions/" + Api::encode(session) + "/band");
       auto band = std::make_shared<const NarrowBand>(decode_lsg(raw.body, "band.lsg").band);
       inbox_.post([this, session, band](AppState& st) {
-        if (st.current == session) local_.set_band(band);
+        if (st.current != session) return;
+        local_.set_band(band);
+        st.band_loaded = true;
       });
     } catch (const std::exception& e) {
       inbox_.post([session, why = describe_error(e)](AppState& st) { st.add_error("band of " + session + ": " + why); });

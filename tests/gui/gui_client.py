@@ -13,7 +13,8 @@ ImGui mouse / keyboard input; the window's state comes back as JSON dumps):
              follow the panel's shading (PUT view); a bad formula shows the server's error with
              its column under the box. Writes SCRATCH/levelset-gui.png (the README's picture).
   sessions   create from a primitive, rename, snapshot, evolve and Stop (the state reached is
-             kept), restore the snapshot, redistance (H), run a job file (its session is shown),
+             kept), restore the snapshot, redistance (H), load a point cloud (J) and reconstruct
+             a session from it, run a job file (its session is shown),
              delete: each checked on the daemon.
   reconnect  a killed daemon shows the banner; the daemon restarted on the same port clears it.
   embedded   no --server: the window starts its own `levelsetd serve --port 0` and stops it on
@@ -37,6 +38,7 @@ from daemon_harness import Daemon  # noqa: E402
 
 GUI, LEVELSETD, SCRATCH, CGAL, SCENARIO = sys.argv[1:6]
 KNOT = os.path.join(CGAL, "meshes", "knot.off")
+POINTS = os.path.join(CGAL, "points_3", "sphere_1k.xyz")
 JOB_FILE = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "configs", "jobs", "evolve_dumbbell.conf")
 PANEL_WIDTH = 420  # client/gui/panels.hpp kPanelWidth
 WIDTH, HEIGHT = 1280, 900
@@ -139,6 +141,7 @@ def workflow_with(daemon):
         "set save_file knot-evolved.ply", "press save_mesh", "wait_idle 60",
         f"screenshot {d}/surface.png", f"dump {d}/after_evolve.json",
         # Above the triangle budget the view switches to the daemon's frames; A goes through PUT view.
+        "click curvature", "wait_idle 60", "frames 3", f"dump {d}/overlay.json", "click none##field",
         "set triangle_budget 1000", "click flat", "frames 2", "wait_surface 60", "frames 30",
         f"screenshot {d}/remote.png", f"dump {d}/remote.json", "set triangle_budget 2000000",
         "click ##formula", "key ctrl+a", f"type '{bad}'", "click Evolve", "wait_formula_error 30", "frames 2",
@@ -171,6 +174,9 @@ def workflow_with(daemon):
     # The README's picture (docs/levelset-gui.png is a copy): 64 colours keep it small.
     Image.open(os.path.join(d, "surface.png")).convert("RGB").quantize(colors=64).save(
         os.path.join(SCRATCH, "levelset-gui.png"), optimize=True)
+    overlay = load_json(os.path.join(d, "overlay.json"))
+    check(overlay["view"]["band_loaded"] and overlay["panel"]["field"] == 3 and not overlay["errors"],
+          f"D's curvature: {overlay['view']} {overlay['errors']}")
     evolve_jobs = [j for j in state["jobs"] if j["op"] == "evolve"]
     check(evolve_jobs and evolve_jobs[0]["fraction"] == 1.0, f"the evolve job's progress: {evolve_jobs}")
     remote = load_json(os.path.join(d, "remote.json"))
@@ -214,6 +220,9 @@ def sessions_with(daemon):
         "wait_idle 120", "wait_surface 60", f"dump {d}/stopped.json",
         "press restore", "wait_idle 30", "wait_surface 60", f"dump {d}/restored.json",
         "press redistance", "wait_idle 120", "wait_surface 60", f"dump {d}/redistanced.json",
+        # J and I: a point cloud shown with the session, then a session reconstructed from it.
+        f"set points_file {POINTS}", "press load_points", "set cloud 1", "wait_idle 60", f"dump {d}/points.json",
+        "press reconstruct", "wait_idle 180", "wait_surface 60", f"dump {d}/reconstructed.json",
         f"set job_file {JOB_FILE}", "set_job_overrides", "press run_job_file", "wait_idle 180", "wait_surface 60",
         f"dump {d}/job_file.json", "press delete", "wait_idle 30", "frames 5", f"dump {d}/deleted.json"]
     script.remove("set_job_overrides")
@@ -235,8 +244,14 @@ def sessions_with(daemon):
     check(restored["version"] == 3 and restored["view"]["mesh_version"] == 3, f"restore: {restored['version']}")
     redist = load_json(os.path.join(d, "redistanced.json"))
     check(redist["version"] == 4 and not redist["errors"], f"redistance: v{redist['version']} {redist['errors']}")
+    _, _, with_points = daemon.get(f"/api/v1/sessions/{sid}")
+    check(with_points.get("points"), f"the point cloud is not attached: {with_points.get('points')}")
+    rec = load_json(os.path.join(d, "reconstructed.json"))
+    check(rec["session"] not in ("", sid) and rec["view"]["triangles"] > 100 and not rec["errors"],
+          f"reconstruct: {rec['session']} {rec['view']} {rec['errors']}")
     made = load_json(os.path.join(d, "job_file.json"))
-    check(made["session"] and made["session"] != sid and made["view"]["triangles"] > 0, f"job file: {made['session']}")
+    check(made["session"] not in ("", sid, rec["session"]) and made["view"]["triangles"] > 0,
+          f"job file: {made['session']}")
     check(any(j["op"] == "job" or j["op"] == "evolve" for j in made["jobs"] if j["mine"]), f"jobs: {made['jobs']}")
     deleted = load_json(os.path.join(d, "deleted.json"))
     status, _, _ = daemon.get(f"/api/v1/sessions/{made['session']}")
@@ -319,6 +334,9 @@ def scenario_embedded():
         check(s.connect_ex(("127.0.0.1", port)) != 0, "the embedded daemon's port still answers")
     settings = load_json(os.path.join(SCRATCH, "embedded", "config", "levelset", "gui.json"))
     check(settings["panel"]["formula"] == "0.25 - H" and settings["server"] == "", f"settings: {settings}")
+    check(settings["window"] == [WIDTH, HEIGHT], f"window size: {settings['window']}")
+    mode = os.stat(os.path.join(SCRATCH, "embedded", "config", "levelset", "gui.json")).st_mode & 0o777
+    check(mode == 0o600, f"the settings file (it may hold a token) has mode {oct(mode)}")
 
     # Run 2: the settings come back; SIGTERM to the window also stops its daemon.
     script = ["wait_connected 60", f"dump {SCRATCH}/embedded/run2.json", "frames 100000000"]
