@@ -62,6 +62,17 @@ Settings App::settings() const {
   return s;
 }
 
+// At the first connection with nothing shown, the most recently updated session is shown.
+void App::select_newest_once() {
+  if (auto_selected_ || !state_.connected) return;
+  auto_selected_ = true;
+  if (!state_.current.empty() || !state_.sessions.is_array() || state_.sessions.empty()) return;
+  const json* newest = nullptr;
+  for (const json& s : state_.sessions)
+    if (newest == nullptr || s.value("updated", "") > newest->value("updated", "")) newest = &s;
+  actions_.select_session(newest->value("id", ""));
+}
+
 void App::sync_streams() {
   streams_.reap();
   if (state_.current != watched_) {
@@ -123,6 +134,7 @@ bool App::frame(ScriptRunner* script) {
   glfwPollEvents();
   if (glfwWindowShouldClose(window_)) state_.quit = true;
   inbox_.apply(state_);
+  select_newest_once();
   sync_streams();
   int fb_w = 0, fb_h = 0;
   glfwGetFramebufferSize(window_, &fb_w, &fb_h);

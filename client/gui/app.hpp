@@ -51,6 +51,7 @@ class App {
 
  private:
   void sync_streams();
+  void select_newest_once();
   void push_view_if_changed(const render::ViewSettings& view);
   void draw_scene(const render::ViewSettings& view, int fb_w, int fb_h);
   void count_fps();
@@ -72,6 +73,7 @@ class App {
   WidgetRegistry widgets_;
   PanelContext panel_;
   std::string watched_;           // the session whose events are followed
+  bool auto_selected_ = false;    // the newest session was shown at the first connection
   nlohmann::json pushed_view_;    // the view last sent with PUT .../view
   std::string pushed_session_;
   std::shared_ptr<std::atomic<bool>> view_in_flight_ = std::make_shared<std::atomic<bool>>(false);

@@ -67,7 +67,11 @@ int run_loop(App& app, ScriptRunner* script, const Options& o) {
       return 3;
     }
     const bool script_done = script != nullptr && script->finished();
-    const bool surface_shown = script == nullptr && app.state().mesh_version >= 0 && app.network_idle();
+    // Without a script, --screenshot waits for the shown session's surface (or a few frames when
+    // the server has no session), then quits.
+    const AppState& st = app.state();
+    const bool surface_shown = script == nullptr && st.connected && app.network_idle() &&
+                               (st.current.empty() ? app.frame_count() > 30 : st.mesh_version == st.version() || st.frames_received > 0);
     if (!o.screenshot.empty() && !shot_taken && (script_done || surface_shown)) {
       app.write_screenshot(o.screenshot);
       shot_taken = true;

@@ -55,11 +55,13 @@ void draw_panel(PanelContext& c, float height) {
 
 void draw_overlay(const AppState& s, float scene_x, float width) {
   ImGui::SetNextWindowPos(ImVec2(scene_x + 8, 8));
+  // The scene's width less a margin; the height follows the lines (auto-resize).
+  ImGui::SetNextWindowSizeConstraints(ImVec2(width - 16, 0), ImVec2(width - 16, 10000));
   ImGui::SetNextWindowBgAlpha(0.55f);
   ImGui::Begin("##overlay", nullptr,
                ImGuiWindowFlags_NoDecoration | ImGuiWindowFlags_NoInputs | ImGuiWindowFlags_NoFocusOnAppearing |
                    ImGuiWindowFlags_NoNav | ImGuiWindowFlags_AlwaysAutoResize);
-  ImGui::PushTextWrapPos(ImGui::GetCursorPosX() + width - 40);
+  ImGui::PushTextWrapPos(0);
   if (!s.banner.empty()) {
     ImGui::PushStyleColor(ImGuiCol_Text, ImVec4(1, 0.3f, 0.25f, 1));
     ImGui::TextWrapped("%s", s.banner.c_str());

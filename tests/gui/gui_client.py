@@ -19,7 +19,8 @@ ImGui mouse / keyboard input; the window's state comes back as JSON dumps):
   reconnect  a killed daemon shows the banner; the daemon restarted on the same port clears it.
   embedded   no --server: the window starts its own `levelsetd serve --port 0` and stops it on
              exit, by its script's quit and on SIGTERM (no process left behind); the settings
-             file keeps the panel between runs.
+             file keeps the panel between runs; with no script, --screenshot shows the newest
+             session, writes the PNG and quits.
 Missing tools (PIL, the binaries, the knot) fail the test; nothing is skipped.
 """
 import json
@@ -352,6 +353,15 @@ def scenario_embedded():
     rc = proc.wait(timeout=60)
     check(rc == 0, f"SIGTERM: the window exited {rc}")
     check(not process_alive(pid2), f"levelsetd {pid2} outlived the window's SIGTERM")
+
+    # Run 3: no script: --screenshot shows the newest session (run 1's torus), writes and quits.
+    shot = os.path.join(d, "shot.png")
+    log = open(os.path.join(d, "run3.log"), "wb")
+    rc = subprocess.run([GUI, "--screenshot", shot, "--width", str(WIDTH), "--height", str(HEIGHT)], stdout=log,
+                        stderr=subprocess.STDOUT, env=gui_env("embedded"), cwd=d, timeout=120).returncode
+    check(rc == 0, f"--screenshot run exited {rc}")
+    stats = image_stats(shot)
+    check(stats["surface_fraction"] > 0.02 and stats["panel_levels"] >= 8, f"--screenshot image: {stats}")
 
 
 def main():
