@@ -2,6 +2,7 @@
 
 #include <chrono>
 
+#include "lib/client_error.hpp"
 #include "lib/job_follow.hpp"
 
 namespace levelset::gui {
@@ -57,10 +58,17 @@ bool ConnectionMonitor::poll_once(const client::Api& api) {
     });
     return true;
   } catch (const std::exception& e) {
-    inbox_.post([why = describe_error(e)](AppState& s) {
-      if (s.connected || s.banner.empty()) s.add_log("connection lost: " + why);
+    // An HTTP answer (401, 403, 503 ...) means the server is there but refuses: say so, not
+    // "connection lost"; both keep being retried (a token can be given, a server can come back).
+    const auto* ce = dynamic_cast<const client::ClientError*>(&e);
+    const bool refused = ce != nullptr && ce->kind() == client::ClientError::Kind::Server;
+    inbox_.post([why = describe_error(e), refused](AppState& s) {
+      const std::string banner = refused ? "The server " + s.server + " refuses this window (" + why +
+                                               "): check the token (Sessions tab) and press Connect; retrying..."
+                                         : "Connection lost to " + s.server + " (" + why + "); reconnecting...";
+      if (s.connected || s.banner != banner) s.add_log(refused ? "refused: " + why : "connection lost: " + why);
       s.connected = false;
-      s.banner = "Connection lost to " + s.server + " (" + why + "); reconnecting...";
+      s.banner = banner;
     });
     return false;
   }

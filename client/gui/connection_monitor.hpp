@@ -1,7 +1,8 @@
 // ConnectionMonitor: one thread that asks the server for GET /api/v1 every `period` seconds
 // (and, when it answers, the session and job lists). A failure shows the banner ("connection
-// lost ... reconnecting"); the next answer clears it. It keeps trying for as long as it runs,
-// so a restarted daemon is found again without the user doing anything.
+// lost ... reconnecting", or "refuses" for an HTTP error such as 401); the next answer clears
+// it. It keeps trying for as long as it runs, so a restarted daemon is found again without the
+// user doing anything.
 #pragma once
 
 #include <atomic>

@@ -17,6 +17,9 @@ ImGui mouse / keyboard input; the window's state comes back as JSON dumps):
              a session from it, run a job file (its session is shown),
              delete: each checked on the daemon.
   reconnect  a killed daemon shows the banner; the daemon restarted on the same port clears it.
+  auth       a daemon with tokens: a wrong token shows the "refuses" banner, a read-only token
+             gets the server's "forbidden" error when it creates a session, a read-write token
+             works and is remembered.
   embedded   no --server: the window starts its own `levelsetd serve --port 0` and stops it on
              exit, by its script's quit and on SIGTERM (no process left behind); the settings
              file keeps the panel between runs; with no script, --screenshot shows the newest
@@ -296,6 +299,33 @@ def scenario_reconnect():
     check(after["session"] == banner["session"] and after["version"] >= 1, "the session did not come back")
 
 
+def scenario_auth():
+    tokens = os.path.join(SCRATCH, "tokens.txt")
+    with open(tokens, "w") as f:
+        f.write("rw-secret-token-123 rw\nro-secret-token-456 ro\n")
+    daemon = Daemon(LEVELSETD, os.path.join(SCRATCH, "data"), "--token-file", tokens)
+    d = os.path.join(SCRATCH, "auth")
+    script = ["wait_disconnected 30", "frames 3", f"dump {d}/refused.json",
+              f"connect {daemon.url} ro-secret-token-456", "wait_connected 30", "set primitive sphere",
+              "set resolution 32", "press create_primitive", "wait_error forbidden 30", f"dump {d}/read_only.json",
+              f"connect {daemon.url} rw-secret-token-123", "wait_connected 30", "clear_errors", "press create_primitive",
+              "wait_session 60", "wait_surface 60", "expect_no_errors", f"dump {d}/read_write.json"]
+    try:
+        proc, d = start_gui("auth", script, "--server", daemon.url, "--token", "wrong-token")
+        finish_gui(proc, d)
+    finally:
+        daemon.stop()
+    refused = load_json(os.path.join(d, "refused.json"))
+    check(not refused["connected"] and "refuses" in refused["banner"] and "unauthorized" in refused["banner"],
+          f"banner for a wrong token: {refused['banner']!r}")
+    ro = load_json(os.path.join(d, "read_only.json"))
+    check(any("forbidden" in e and "read-only" in e for e in ro["errors"]), f"read-only token: {ro['errors']}")
+    rw = load_json(os.path.join(d, "read_write.json"))
+    check(rw["connected"] and rw["session"] and rw["view"]["triangles"] > 0, f"read-write token: {rw['view']}")
+    settings = load_json(os.path.join(SCRATCH, "auth", "config", "levelset", "gui.json"))
+    check(settings["token"] == "rw-secret-token-123", "the token given with Connect was not kept")
+
+
 def process_alive(pid):
     try:
         with open(f"/proc/{pid}/stat") as f:
@@ -372,7 +402,7 @@ def main():
     os.makedirs(SCRATCH)
     t0 = time.monotonic()
     {"workflow": scenario_workflow, "sessions": scenario_sessions, "reconnect": scenario_reconnect,
-     "embedded": scenario_embedded}[SCENARIO]()
+     "auth": scenario_auth, "embedded": scenario_embedded}[SCENARIO]()
     print(f"gui {SCENARIO}: ok in {time.monotonic() - t0:.1f} s")
 
 
