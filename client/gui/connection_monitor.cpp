@@ -1,5 +1,6 @@
 #include "connection_monitor.hpp"
 
+#include <algorithm>
 #include <chrono>
 
 #include "lib/client_error.hpp"
@@ -54,6 +55,10 @@ bool ConnectionMonitor::poll_once(const client::Api& api) {
             r.mine = old.mine;
             if (r.state == "running" && old.state == "running" && old.fraction > r.fraction) r.fraction = old.fraction;
           }
+      // A job submitted here after the list was read is not in it yet: keep its row.
+      for (const JobRow& old : s.jobs)
+        if (old.mine && std::none_of(rows.begin(), rows.end(), [&](const JobRow& r) { return r.id == old.id; }))
+          rows.push_back(old);
       s.jobs = std::move(rows);
     });
     return true;

@@ -85,6 +85,31 @@ void EventStreams::session_loop(Stream& self, std::string id) {
   }
 }
 
+namespace {
+
+void apply_job_end(AppState& s, const std::string& id, const json& job, const json& session) {
+  const std::string state = job.value("state", "");
+  if (s.select_after_job == id) {
+    if (state == "succeeded" && session.is_object()) s.current = session.value("id", "");
+    s.select_after_job.clear();
+  }
+  if (session.is_object() && session.value("id", "") == s.current) s.session = session;
+  for (JobRow& j : s.jobs)
+    if (j.id == id) {
+      j.state = state;
+      if (state == "succeeded") j.fraction = 1;
+    }
+  if (state == "failed" || (state != "succeeded" && job.value("error", json()).is_object())) {
+    const json err = job.value("error", json::object());
+    s.add_error("job " + id + " (" + job.value("op", "") + ") " + state + ": " + err.value("code", "") + ": " +
+                err.value("message", ""));
+  } else {
+    s.add_log("job " + id + " (" + job.value("op", "") + ") " + state);
+  }
+}
+
+}  // namespace
+
 void EventStreams::job_loop(Stream& self, std::string id) {
   client::FollowCallbacks cb;
   cb.stop = &self.stop;
@@ -104,27 +129,19 @@ void EventStreams::job_loop(Stream& self, std::string id) {
     if (!api) return;
     const json job = client::follow_job(*api, id, cb);
     if (job.is_null()) return;
-    inbox_.post([id, job](AppState& s) {
-      const std::string state = job.value("state", "");
-      const json result = job.value("result", json::object());
-      if (s.select_after_job == id && state == "succeeded" && result.is_object() && result.contains("session") &&
-          result["session"].is_string()) {
-        s.current = result["session"].get<std::string>();
-        s.select_after_job.clear();
+    // The session the job changed or made, read now: the job's end and the version it made reach
+    // the window together (the session's own stream may deliver the version a moment later).
+    json session;
+    const json result = job.value("result", json::object());
+    std::string sid = job.value("session", json()).is_string() ? job["session"].get<std::string>() : "";
+    if (result.is_object() && result.contains("session") && result["session"].is_string()) sid = result["session"];
+    if (!sid.empty() && job.value("state", "") == "succeeded") {
+      try {
+        session = api->get("/api/v1/sessions/" + client::Api::encode(sid));
+      } catch (const std::exception&) {  // the session stream brings it later
       }
-      for (JobRow& j : s.jobs)
-        if (j.id == id) {
-          j.state = state;
-          if (state == "succeeded") j.fraction = 1;
-        }
-      if (state == "failed" || (state != "succeeded" && job.value("error", json()).is_object())) {
-        const json err = job.value("error", json::object());
-        s.add_error("job " + id + " (" + job.value("op", "") + ") " + state + ": " + err.value("code", "") + ": " +
-                    err.value("message", ""));
-      } else {
-        s.add_log("job " + id + " (" + job.value("op", "") + ") " + state);
-      }
-    });
+    }
+    inbox_.post([id, job, session](AppState& s) { apply_job_end(s, id, job, session); });
   } catch (const std::exception& e) {
     inbox_.post([id, why = describe_error(e)](AppState& s) { s.add_error("job " + id + ": " + why); });
   }

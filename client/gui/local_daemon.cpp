@@ -35,13 +35,24 @@ std::string find_levelsetd(const std::string& self_exe) {
   return "";
 }
 
+std::string default_daemon_log() {
+  const char* xdg = std::getenv("XDG_STATE_HOME");
+  const char* home = std::getenv("HOME");
+  const fs::path base = xdg != nullptr && *xdg != '\0' ? fs::path(xdg) : fs::path(home != nullptr ? home : ".") / ".local" / "state";
+  std::error_code ec;
+  fs::create_directories(base / "levelset-gui", ec);
+  return (base / "levelset-gui" / "daemon.log").string();
+}
+
 namespace {
 
-// The child: its own stdout to the pipe, dies with its parent.
-[[noreturn]] void exec_child(const std::string& binary, const std::string& data_dir, int pipe_write, pid_t parent) {
+// The child: its own stdout to the pipe, stderr to the log, dies with its parent.
+[[noreturn]] void exec_child(const std::string& binary, const std::string& data_dir, int pipe_write, int log_fd,
+                             pid_t parent) {
   ::prctl(PR_SET_PDEATHSIG, SIGTERM);
   if (::getppid() != parent) ::_exit(127);  // the parent died before prctl
   ::dup2(pipe_write, STDOUT_FILENO);
+  if (log_fd >= 0) ::dup2(log_fd, STDERR_FILENO);
   std::vector<std::string> args = {binary, "serve", "--port", "0"};
   if (!data_dir.empty()) args.insert(args.end(), {"--data", data_dir});
   std::vector<char*> argv;
@@ -53,14 +64,17 @@ namespace {
 
 }  // namespace
 
-LocalDaemon::LocalDaemon(const std::string& binary, const std::string& data_dir, double timeout) {
+LocalDaemon::LocalDaemon(const std::string& binary, const std::string& data_dir, const std::string& log_file,
+                         double timeout) {
   int fds[2];
   if (::pipe2(fds, O_CLOEXEC) != 0) throw std::runtime_error("pipe failed");
+  const int log_fd = log_file.empty() ? -1 : ::open(log_file.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0600);
   const pid_t parent = ::getpid();
   pid_ = ::fork();
   if (pid_ < 0) throw std::runtime_error("fork failed");
-  if (pid_ == 0) exec_child(binary, data_dir, fds[1], parent);
+  if (pid_ == 0) exec_child(binary, data_dir, fds[1], log_fd, parent);
   ::close(fds[1]);
+  if (log_fd >= 0) ::close(log_fd);
   out_fd_ = fds[0];
   std::string line;
   const auto deadline = Clock::now() + std::chrono::duration<double>(timeout);
@@ -76,7 +90,8 @@ LocalDaemon::LocalDaemon(const std::string& binary, const std::string& data_dir,
   const std::string prefix = "levelsetd listening on ";
   if (line.rfind(prefix, 0) != 0) {
     stop(5);
-    throw std::runtime_error(binary + " serve did not start" + (line.empty() ? "" : ": " + line));
+    throw std::runtime_error(binary + " serve did not start" + (line.empty() ? "" : ": " + line) +
+                             (log_file.empty() ? "" : " (its log: " + log_file + ")"));
   }
   url_ = line.substr(prefix.size());
 }

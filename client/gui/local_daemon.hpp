@@ -14,12 +14,16 @@ namespace levelset::gui {
 // levelsetd beside this executable (same folder, or ../../server/ in a build tree), else on PATH;
 // "" when none is found.
 std::string find_levelsetd(const std::string& self_exe);
+// $XDG_STATE_HOME/levelset-gui/daemon.log (~/.local/state/... without it); its folder is made.
+std::string default_daemon_log();
 
 class LocalDaemon {
  public:
   // Throws std::runtime_error naming the binary and what it printed when it does not start in
-  // `timeout` seconds.
-  LocalDaemon(const std::string& binary, const std::string& data_dir, double timeout = 30);
+  // `timeout` seconds. Its log (stderr: a line per request) goes to `log_file` (truncated; ""
+  // or unwritable: this process's stderr).
+  LocalDaemon(const std::string& binary, const std::string& data_dir, const std::string& log_file,
+              double timeout = 30);
   ~LocalDaemon();
   LocalDaemon(const LocalDaemon&) = delete;
   LocalDaemon& operator=(const LocalDaemon&) = delete;

@@ -98,9 +98,10 @@ int main(int argc, char** argv) {
     if (o.server.empty() && (o.embedded || settings.server.empty())) {
       const std::string binary = o.levelsetd.empty() ? find_levelsetd("/proc/self/exe") : o.levelsetd;
       if (binary.empty()) throw std::runtime_error("no levelsetd beside levelset-gui or on PATH (give --levelsetd or --server)");
-      daemon = std::make_unique<LocalDaemon>(binary, o.data_dir);
-      std::fprintf(stderr, "levelset-gui: started %s serve (pid %d) on %s\n", binary.c_str(), int(daemon->pid()),
-                   daemon->url().c_str());
+      const std::string log = default_daemon_log();
+      daemon = std::make_unique<LocalDaemon>(binary, o.data_dir, log);
+      std::fprintf(stderr, "levelset-gui: started %s serve (pid %d) on %s; its log: %s\n", binary.c_str(),
+                   int(daemon->pid()), daemon->url().c_str(), log.c_str());
     }
   } catch (const std::exception& e) {
     std::fprintf(stderr, "levelset-gui: %s\n", e.what());

@@ -360,6 +360,8 @@ def scenario_embedded():
     run1 = load_json(os.path.join(d, "run1.json"))
     finish_gui(proc, d)
     check(not process_alive(pid), f"levelsetd {pid} outlived the window")
+    with open(os.path.join(SCRATCH, "embedded", "state", "levelset-gui", "daemon.log")) as f:
+        check("GET /api/v1" in f.read(), "the embedded daemon's log is not in $XDG_STATE_HOME/levelset-gui")
     port = int(run1["server"].rsplit(":", 1)[1])
     with socket.socket() as s:
         check(s.connect_ex(("127.0.0.1", port)) != 0, "the embedded daemon's port still answers")
