@@ -49,6 +49,13 @@ void Actions::report(const std::exception& e, const std::string& what) {
 void Actions::connect(const std::string& server, const std::string& token) {
   try {
     c_.api.set(std::make_shared<const Api>(server, token));
+    if (server != c_.state.server) {  // another server: nothing shown belongs to it
+      select_session("");
+      c_.state.sessions = json::array();
+      c_.state.jobs.clear();
+      c_.state.mesh_upload.clear();
+      c_.state.points_upload.clear();
+    }
     c_.state.server = server;
     c_.state.token = token;
     c_.state.connected = false;

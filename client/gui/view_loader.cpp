@@ -1,5 +1,6 @@
 #include "view_loader.hpp"
 
+#include <chrono>
 #include <cstdio>
 
 #include "grid/lsg_file.hpp"
@@ -22,7 +23,10 @@ void ViewLoader::update(AppState& s, int w, int h) {
   const std::uint64_t budget = std::uint64_t(std::max(1, p.triangle_budget));
   s.remote = p.view_mode == 2 ||
              (p.view_mode == 0 && !s.current.empty() && (estimated_triangles(s.session) > budget || s.mesh_triangles > budget));
-  remote_.show(s.remote && s.connected ? s.current : "", w, h);
+  const double now = std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+  if (w != asked_w_ || h != asked_h_) asked_w_ = w, asked_h_ = h, asked_since_ = now;
+  if (stream_w_ == 0 || now - asked_since_ > 0.3) stream_w_ = asked_w_, stream_h_ = asked_h_;
+  remote_.show(s.remote && s.connected ? s.current : "", stream_w_, stream_h_);
   if (s.current != session_ && !s.current.empty()) {
     // Another session: drop the old one's geometry (a mesh file previewed before B stays until then).
     local_.clear();

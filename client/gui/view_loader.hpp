@@ -38,6 +38,10 @@ class ViewLoader {
   std::string session_;            // the session the local scene belongs to
   std::string mesh_key_, band_key_;  // what was last asked for: session@version@iso
   std::string etag_;
+  // The frame stream's size follows the window only once a resize has settled (0.3 s): each
+  // new size opens a new stream.
+  int stream_w_ = 0, stream_h_ = 0, asked_w_ = 0, asked_h_ = 0;
+  double asked_since_ = 0;
 };
 
 }  // namespace levelset::gui

@@ -113,6 +113,13 @@ def image_stats(path):
             "lum_spread": lum[int(0.95 * (len(lum) - 1))] - lum[int(0.05 * (len(lum) - 1))]}
 
 
+def scene_fraction(path, pred):
+    img = Image.open(path).convert("RGB")
+    px = img.load()
+    scene = [px[x, y] for x in range(PANEL_WIDTH, WIDTH, 3) for y in range(60, HEIGHT, 3)]
+    return sum(1 for p in scene if pred(p)) / len(scene)
+
+
 def red_pixels(path, box):
     img = Image.open(path).convert("RGB")
     px = img.load()
@@ -146,6 +153,9 @@ def workflow_with(daemon):
         f"screenshot {d}/surface.png", f"dump {d}/after_evolve.json",
         # Above the triangle budget the view switches to the daemon's frames; A goes through PUT view.
         "click curvature", "wait_idle 60", "frames 3", f"dump {d}/overlay.json", "click none##field",
+        # The band's slice (z) and volume rendering (View tab settings).
+        "set slice 3", "frames 3", f"screenshot {d}/slice.png", "set slice 0", "set volume true", "click none",
+        "frames 2", f"screenshot {d}/volume.png", "set volume false",
         "set triangle_budget 1000", "click flat", "frames 2", "wait_surface 60", "frames 30",
         f"screenshot {d}/remote.png", f"dump {d}/remote.json", "set triangle_budget 2000000",
         "click ##formula", "key ctrl+a", f"type '{bad}'", "click Evolve", "wait_formula_error 30", "frames 2",
@@ -181,6 +191,11 @@ def workflow_with(daemon):
     overlay = load_json(os.path.join(d, "overlay.json"))
     check(overlay["view"]["band_loaded"] and overlay["panel"]["field"] == 3 and not overlay["errors"],
           f"D's curvature: {overlay['view']} {overlay['errors']}")
+    blue = scene_fraction(os.path.join(d, "slice.png"), lambda p: p[2] > 150 and p[0] < 120)
+    check(blue > 0.05, f"no slice coloured by distance ({blue:.3f} of the scene)")
+    lit = scene_fraction(os.path.join(d, "volume.png"), lambda p: sum(p) > 300)
+    check(lit > 0.05, f"no volume rendering without the surface ({lit:.3f} of the scene)")
+    print(f"slice {blue:.3f}, volume {lit:.3f} of the scene")
     evolve_jobs = [j for j in state["jobs"] if j["op"] == "evolve"]
     check(evolve_jobs and evolve_jobs[0]["fraction"] == 1.0, f"the evolve job's progress: {evolve_jobs}")
     remote = load_json(os.path.join(d, "remote.json"))
