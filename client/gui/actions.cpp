@@ -1,17 +1,10 @@
+// Actions for the server, sessions and jobs (the thesis panel's are in actions_thesis.cpp).
 #include "actions.hpp"
 
-#include <filesystem>
-
-#include "core/error.hpp"
-#include "core/file_io.hpp"
-#include "io/mesh_reader.hpp"
-#include "io/point_cloud_reader.hpp"
 #include "lib/client_error.hpp"
-#include "lib/job_inputs.hpp"
 
 namespace levelset::gui {
 
-namespace fs = std::filesystem;
 using nlohmann::json;
 using client::Api;
 

@@ -3,7 +3,6 @@
 
 #include "actions.hpp"
 #include "config/config_file.hpp"
-#include "core/error.hpp"
 #include "core/file_io.hpp"
 #include "io/mesh_reader.hpp"
 #include "io/point_cloud_reader.hpp"

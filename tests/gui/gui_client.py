@@ -235,7 +235,8 @@ def sessions_with(daemon):
         "wait_surface 60", "set new_name ball", "press rename", "set snapshot_name before", "press snapshot",
         "wait_idle 30", f"dump {d}/snapshot.json",
         # G's Stop: a long evolution ends at a step boundary with the state reached.
-        "set formula -H", "set steps 100000", "press evolve", "wait_running 60", "frames 20", "click Stop",
+        # A slow outward speed: the sphere must not vanish (it would end the job) before Stop.
+        "set formula 0.001", "set steps 100000", "press evolve", "wait_running 60", "frames 20", "click Stop",
         "wait_idle 120", "wait_surface 60", f"dump {d}/stopped.json",
         "press restore", "wait_idle 30", "wait_surface 60", f"dump {d}/restored.json",
         "press redistance", "wait_idle 120", "wait_surface 60", f"dump {d}/redistanced.json",
