@@ -108,12 +108,12 @@ void App::push_view_if_changed(const render::ViewSettings& view) {
   });
 }
 
-void App::draw_scene(const render::ViewSettings& view, int fb_w, int fb_h) {
+void App::draw_scene(const render::ViewSettings& view, int scene_x, int fb_w, int fb_h) {
   gl_.Viewport(0, 0, fb_w, fb_h);
   gl_.ClearColor(view.background[0], view.background[1], view.background[2], 1);
   gl_.Clear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
   if (!state_.remote && !scene_.empty()) {
-    scene_.draw(view, int(kPanelWidth), 0, fb_w - int(kPanelWidth), fb_h);
+    scene_.draw(view, scene_x, 0, fb_w - scene_x, fb_h);
     gl_.Viewport(0, 0, fb_w, fb_h);
   }
 }
@@ -136,9 +136,13 @@ bool App::frame(ScriptRunner* script) {
   inbox_.apply(state_);
   select_newest_once();
   sync_streams();
-  int fb_w = 0, fb_h = 0;
+  // ImGui lays out in window coordinates, GL draws in framebuffer pixels (more on a HiDPI screen).
+  int fb_w = 0, fb_h = 0, win_w = 0, win_h = 0;
   glfwGetFramebufferSize(window_, &fb_w, &fb_h);
-  const int scene_w = std::max(render::kMinSize, fb_w - int(kPanelWidth)), scene_h = std::max(render::kMinSize, fb_h);
+  glfwGetWindowSize(window_, &win_w, &win_h);
+  const float scale = win_w > 0 ? float(fb_w) / float(win_w) : 1.0f;
+  const int scene_x = int(kPanelWidth * scale);
+  const int scene_w = std::max(render::kMinSize, fb_w - scene_x), scene_h = std::max(render::kMinSize, fb_h);
   loader_.update(state_, scene_w, scene_h);
   if (auto image = remote_.take_frame()) {
     texture_.upload(*image);
@@ -152,16 +156,16 @@ bool App::frame(ScriptRunner* script) {
   ui::registry = &widgets_;
   widgets_.begin_frame();
   camera_.handle_input(state_.panel, kPanelWidth);
-  draw_panel(panel_, float(fb_h));
-  draw_overlay(state_, kPanelWidth, float(scene_w));
+  draw_panel(panel_, float(win_h));
+  draw_overlay(state_, kPanelWidth, float(win_w) - kPanelWidth);
   if (state_.remote && texture_.id() != 0 && state_.frames_received > 0)
     ImGui::GetBackgroundDrawList()->AddImage(reinterpret_cast<ImTextureID>(std::intptr_t(texture_.id())),
-                                             ImVec2(kPanelWidth, 0), ImVec2(float(fb_w), float(fb_h)));
+                                             ImVec2(kPanelWidth, 0), ImVec2(float(win_w), float(win_h)));
   ImGui::Render();
 
   const render::ViewSettings view = view_from_panel(state_.panel, camera_, scene_w, scene_h);
   push_view_if_changed(view);
-  draw_scene(view, fb_w, fb_h);
+  draw_scene(view, scene_x, fb_w, fb_h);
   ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
   if (!actions_.screenshot_request.empty()) {
     write_screenshot(actions_.screenshot_request);

@@ -53,7 +53,7 @@ class App {
   void sync_streams();
   void select_newest_once();
   void push_view_if_changed(const render::ViewSettings& view);
-  void draw_scene(const render::ViewSettings& view, int fb_w, int fb_h);
+  void draw_scene(const render::ViewSettings& view, int scene_x, int fb_w, int fb_h);
   void count_fps();
 
   GLFWwindow* window_;
