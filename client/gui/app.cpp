@@ -208,6 +208,7 @@ json App::dump() const {
                     {"frames_received", state_.frames_received}, {"fps", state_.fps},
                     {"band_loaded", state_.band_loaded}}},
           {"frames", frames_},
+          {"camera", {{"yaw", camera_.camera.yaw}, {"pitch", camera_.camera.pitch}, {"zoom", camera_.camera.zoom}}},
           {"panel", panel_to_json(state_.panel)},
           {"widgets", widgets},
           {"log", std::vector<std::string>(state_.log.begin(), state_.log.end())}};

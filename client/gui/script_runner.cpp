@@ -9,6 +9,7 @@
 #include <stdexcept>
 
 #include "app.hpp"
+#include "panels.hpp"
 #include "core/file_io.hpp"
 
 namespace levelset::gui {
@@ -48,7 +49,7 @@ std::vector<std::string> split_words(const std::string& text, int number) {
 
 const std::map<std::string, int>& known_commands() {  // name -> the fewest words after it
   static const std::map<std::string, int> m = {
-      {"connect", 1}, {"set", 2}, {"press", 1}, {"click", 1}, {"type", 1}, {"key", 1}, {"camera", 3}, {"select", 1},
+      {"connect", 1}, {"set", 2}, {"press", 1}, {"click", 1}, {"drag", 2}, {"type", 1}, {"key", 1}, {"camera", 3}, {"select", 1},
       {"wait_connected", 0}, {"wait_disconnected", 0}, {"wait_session", 0}, {"wait_idle", 0}, {"wait_surface", 0}, {"wait_running", 0},
       {"wait_error", 1}, {"wait_formula_error", 0}, {"frames", 1}, {"screenshot", 1}, {"dump", 1},
       {"expect_no_errors", 0}, {"clear_errors", 0}, {"quit", 0}};
@@ -78,6 +79,11 @@ void ScriptRunner::inject(ImGuiIO& io) {
   if (click_phase_ > 0) {
     io.MousePos = mouse_;
     io.MouseDown[0] = click_phase_ == 2;
+  }
+  if (drag_phase_ > 0) {
+    if (drag_phase_ > 2 && drag_phase_ < 12) mouse_ = ImVec2(mouse_.x + drag_step_.x, mouse_.y + drag_step_.y);
+    io.MousePos = mouse_;
+    io.MouseDown[0] = drag_phase_ >= 2 && drag_phase_ < 12;
   }
   if (!typed_.empty()) {
     io.AddInputCharactersUTF8(typed_.c_str());
@@ -137,6 +143,23 @@ ScriptRunner::Step ScriptRunner::click(const Line& line, App& app) {
     return Step::Wait;
   }
   click_phase_ = 0;
+  return Step::Done;
+}
+
+ScriptRunner::Step ScriptRunner::drag(const Line& line, App& app) {
+  if (drag_phase_ == 0) {
+    const ImVec2 size = ImGui::GetIO().DisplaySize;
+    mouse_ = ImVec2((kPanelWidth + size.x) / 2, size.y / 2);  // the scene's centre
+    drag_step_ = ImVec2(float(std::stod(line.words[1])) / 9, float(std::stod(line.words[2])) / 9);
+    drag_phase_ = 1;
+    (void)app;
+    return Step::Wait;
+  }
+  if (drag_phase_ < 12) {
+    ++drag_phase_;
+    return Step::Wait;
+  }
+  drag_phase_ = 0;
   return Step::Done;
 }
 
@@ -208,6 +231,7 @@ ScriptRunner::Step ScriptRunner::run(const Line& line, App& app) {
     return Step::Fail;
   }
   if (cmd == "click") return click(line, app);
+  if (cmd == "drag") return drag(line, app);
   if (cmd == "type") {
     if (key_phase_ == 0 && typed_.empty() && !started_set_) {
       typed_ = arg(1);

@@ -8,6 +8,7 @@
 //       evolve stop redistance extract save_mesh load_points reconstruct screenshot quit
 //       create_primitive rename delete snapshot restore (the newest snapshot) run_job_file
 //   click LABEL                  injected ImGui mouse click at the centre of a labelled control
+//   drag DX DY                   injected left-button drag over the scene (the trackball)
 //   type TEXT                    injected characters (into the focused text box)
 //   key ctrl+a|enter|backspace   an injected key press
 //   camera YAW PITCH ZOOM        select SESSION_ID
@@ -51,6 +52,7 @@ class ScriptRunner {
   Step wait_for(bool condition, const Line& line, const std::string& what);
   Step settle(bool condition, const Line& line, const std::string& what);  // held for 3 frames
   Step click(const Line& line, App& app);
+  Step drag(const Line& line, App& app);
   Step press(const std::string& action, App& app);
   void fail(const Line& line, const std::string& why);
 
@@ -66,6 +68,8 @@ class ScriptRunner {
   // Injected input: a click is move (1 frame), press (1 frame), release.
   int click_phase_ = 0;
   ImVec2 mouse_{-1, -1};
+  int drag_phase_ = 0;  // 1: over the scene, 2..11: pressed and moving, 12: released
+  ImVec2 drag_step_{0, 0};
   std::string typed_, key_;
   int key_phase_ = 0;
 };

@@ -157,7 +157,8 @@ def workflow_with(daemon):
         "set slice 3", "frames 3", f"screenshot {d}/slice.png", "set slice 0", "set volume true", "click none",
         "frames 2", f"screenshot {d}/volume.png", "set volume false",
         "set triangle_budget 1000", "click flat", "frames 2", "wait_surface 60", "frames 30",
-        f"screenshot {d}/remote.png", f"dump {d}/remote.json", "set triangle_budget 2000000",
+        f"screenshot {d}/remote.png", f"dump {d}/remote.json",
+        "drag 200 -50", "frames 5", "wait_idle 30", f"dump {d}/dragged.json", "set triangle_budget 2000000",
         "click ##formula", "key ctrl+a", f"type '{bad}'", "click Evolve", "wait_formula_error 30", "frames 2",
         f"screenshot {d}/formula_error.png", f"dump {d}/formula_error.json",
     ]
@@ -202,6 +203,10 @@ def workflow_with(daemon):
     check(remote["view"]["remote"] and remote["view"]["frames_received"] > 0, f"no remote frames: {remote['view']}")
     status, _, view = daemon.get(f"/api/v1/sessions/{sid}/view")
     check(status == 200 and view["shading"] == "flat", f"the panel's shading did not reach the daemon: {view}")
+    dragged = load_json(os.path.join(d, "dragged.json"))["camera"]
+    check(abs(dragged["yaw"] - 30) > 40 and abs(dragged["pitch"] - 20) > 10, f"the drag did not orbit: {dragged}")
+    check(abs(view["camera"]["yaw"] - dragged["yaw"]) < 1e-6 and abs(view["camera"]["pitch"] - dragged["pitch"]) < 1e-6,
+          f"the daemon's camera {view['camera']} is not the window's {dragged}")
     stats = image_stats(os.path.join(d, "remote.png"))
     print("remote.png", stats)
     check(stats["surface_fraction"] > 0.05 and stats["lum_spread"] > 20, f"no surface in the remote frame: {stats}")
