@@ -118,6 +118,14 @@ void App::draw_scene(const render::ViewSettings& view, int scene_x, int fb_w, in
   }
 }
 
+// K and L from the keyboard: F12 screenshot, Ctrl+Q quit (not while typing into a box).
+void App::handle_shortcuts() {
+  const ImGuiIO& io = ImGui::GetIO();
+  if (io.WantCaptureKeyboard) return;
+  if (ImGui::IsKeyPressed(GLFW_KEY_F12, false)) actions_.request_screenshot();
+  if (io.KeyCtrl && ImGui::IsKeyPressed(GLFW_KEY_Q, false)) actions_.quit();
+}
+
 void App::count_fps() {
   ++frames_;
   ++fps_window_frames_;
@@ -156,6 +164,7 @@ bool App::frame(ScriptRunner* script) {
   ui::registry = &widgets_;
   widgets_.begin_frame();
   camera_.handle_input(state_.panel, kPanelWidth);
+  handle_shortcuts();
   draw_panel(panel_, float(win_h));
   draw_overlay(state_, kPanelWidth, float(win_w) - kPanelWidth);
   if (state_.remote && texture_.id() != 0 && state_.frames_received > 0)

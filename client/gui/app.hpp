@@ -55,6 +55,7 @@ class App {
   void push_view_if_changed(const render::ViewSettings& view);
   void draw_scene(const render::ViewSettings& view, int scene_x, int fb_w, int fb_h);
   void count_fps();
+  void handle_shortcuts();
 
   GLFWwindow* window_;
   AppState state_;

@@ -24,7 +24,7 @@ void draw_view_controls(PanelContext& c) {
   ui::checkbox("volume rendering", &p.volume);
   ImGui::Separator();
   ImGui::TextWrapped("Camera: drag to orbit, wheel or +/- to zoom, arrows turn 5 degrees, Home resets; 1-5 pick "
-                     "the shading (A).");
+                     "the shading (A); F12 screenshot (K), Ctrl+Q quit (L).");
 }
 
 void draw_panel(PanelContext& c, float height) {

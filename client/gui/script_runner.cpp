@@ -2,7 +2,10 @@
 
 #include <GLFW/glfw3.h>
 
+#include <algorithm>
+#include <cctype>
 #include <cstdio>
+#include <cstdlib>
 #include <fstream>
 #include <map>
 #include <sstream>
@@ -98,6 +101,8 @@ void ScriptRunner::inject(ImGuiIO& io) {
     if (name == "enter") key = GLFW_KEY_ENTER;
     if (name == "backspace") key = GLFW_KEY_BACKSPACE;
     if (name == "home") key = GLFW_KEY_HOME;
+    if (name.size() >= 2 && name[0] == 'f' && std::isdigit(static_cast<unsigned char>(name[1])))
+      key = GLFW_KEY_F1 + std::clamp(std::atoi(name.c_str() + 1), 1, 25) - 1;
     if (key != GLFW_KEY_UNKNOWN) io.KeysDown[key] = down;
     io.KeyCtrl = ctrl && down;
   }

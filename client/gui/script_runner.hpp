@@ -10,7 +10,7 @@
 //   click LABEL                  injected ImGui mouse click at the centre of a labelled control
 //   drag DX DY                   injected left-button drag over the scene (the trackball)
 //   type TEXT                    injected characters (into the focused text box)
-//   key ctrl+a|enter|backspace   an injected key press
+//   key ctrl+a|enter|backspace|home|f12   an injected key press (ctrl+ any letter)
 //   camera YAW PITCH ZOOM        select SESSION_ID
 //   wait_connected / wait_disconnected / wait_session / wait_idle / wait_surface [S]
 //   wait_running [S]             a job of this window runs

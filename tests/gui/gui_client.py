@@ -371,7 +371,10 @@ def children_of(pid):
 def scenario_embedded():
     # Run 1: the script quits; the panel's formula is remembered.
     script = ["wait_connected 60", "set formula '0.25 - H'", "set primitive torus", "set resolution 32",
-              "press create_primitive", "wait_session 60", "wait_surface 60", f"dump {SCRATCH}/embedded/run1.json"]
+              "press create_primitive", "wait_session 60", "wait_surface 60", f"dump {SCRATCH}/embedded/run1.json",
+              # K and L from the keyboard: F12 writes the panel's PNG file, Ctrl+Q ends the window
+              # (the wait after it would fail the script if it did not).
+              "key f12", "frames 3", "key ctrl+q", "wait_error never-shown 60"]
     proc, d = start_gui("embedded", script)
     pid = wait_until(lambda: load_json(os.path.join(d, "run1.json"))["daemon_pid"]
                      if os.path.exists(os.path.join(d, "run1.json")) else 0, "the first dump", 120)
@@ -381,6 +384,7 @@ def scenario_embedded():
     run1 = load_json(os.path.join(d, "run1.json"))
     finish_gui(proc, d)
     check(not process_alive(pid), f"levelsetd {pid} outlived the window")
+    check(Image.open(os.path.join(d, "levelset-gui.png")).size == (WIDTH, HEIGHT), "F12 wrote no screenshot")
     with open(os.path.join(SCRATCH, "embedded", "state", "levelset-gui", "daemon.log")) as f:
         check("GET /api/v1" in f.read(), "the embedded daemon's log is not in $XDG_STATE_HOME/levelset-gui")
     port = int(run1["server"].rsplit(":", 1)[1])
