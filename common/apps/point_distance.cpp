@@ -305,6 +305,18 @@ SheetFit sheet_fit(const PointIndex& index, const Vec3d& x, const Vec3d& n, int 
   const double slope2 = (r[1] * r[1] + r[2] * r[2]) * inv_r * inv_r;
   f.height_offset = -r[0] / std::sqrt(1.0 + slope2);
   f.has_height = true;
+  // The quadric's weighted residual: the points' noise, free of the surface's curvature
+  // (which the quadric absorbs), corrected for the 6 fitted coefficients.
+  double wsum = 0.0, rsum = 0.0;
+  for (int i = 0; i < used; ++i) {
+    const double u = pts[std::size_t(i)].xi * inv_r, v = pts[std::size_t(i)].eta * inv_r;
+    const double w = std::exp(-(u * u + v * v));
+    const double z = r[0] + r[1] * u + r[2] * v + r[3] * u * u + r[4] * u * v + r[5] * v * v;
+    const double e = pts[std::size_t(i)].z - z;
+    wsum += w;
+    rsum += w * e * e;
+  }
+  f.height_residual = std::sqrt(rsum / (wsum * (1.0 - 6.0 / double(used))));
   return f;
 }
 

@@ -121,11 +121,14 @@ LocalFit one_sided_fit(const PointIndex& index, const Vec3d& x, const Vec3d& n, 
 // from x, R the largest among the kept points). height_offset = -c0 / sqrt(1 + |grad z|^2)
 // is x's signed distance to that quadric: no bias from the surface's curvature (the plane /
 // centroid fit's O(rho^2 H)) and no dependence on where the points lie around x, so it
-// needs no curvature correction. has_height is false (height_offset 0) with fewer than 10
+// needs no curvature correction; height_residual, the weighted RMS of the points' heights
+// about the quadric (times sqrt(n / (n - 6))), estimates the noise without the curvature's
+// sagitta that the plane fit's spread carries. has_height is false (height_offset 0) with fewer than 10
 // kept points or an ill-conditioned system. Thread-safe.
 struct SheetFit {
   LocalFit plane;
   double height_offset = 0.0;
+  double height_residual = 0.0;  // the quadric's weighted RMS residual (world): a noise estimate
   bool has_height = false;
 };
 SheetFit sheet_fit(const PointIndex& index, const Vec3d& x, const Vec3d& n, int k, int k_height, double min_band);

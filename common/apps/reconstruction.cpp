@@ -5,6 +5,7 @@
 #include <cmath>
 #include <atomic>
 #include <cstdio>
+#include <cstdlib>
 #include <deque>
 #include <limits>
 #include <optional>
@@ -14,6 +15,7 @@
 #include <tbb/parallel_for.h>
 
 #include "apps/point_distance.hpp"
+#include "apps/point_sampling.hpp"
 #include "core/error.hpp"
 #include "distance/redistance.hpp"
 #include "evolve/evolution.hpp"
@@ -98,6 +100,11 @@ constexpr long kMaxSmoothing = 3;
 constexpr int kNoisyHeightNeighbors = 48;
 constexpr double kReferenceDensity = 0.15;
 constexpr double kDensityExponent = 0.75;
+// The noise (final voxels) at which kNoisyHeightNeighbors was measured best (0.2% noise).
+constexpr double kReferenceNoise = 0.7;
+// The height fits' residual on clean points (the quadric's third-order misfit, float
+// positions): 0.01-0.03 final voxels measured; residuals are counted as noise beyond it.
+constexpr double kResidualFloor = 0.1;
 // Voxels within this many voxels of the front compute fits on a first pass; the others in the
 // snap window take their neighbours' mean offset (the offset is nearly constant along the
 // normal; bench_reconstruct: the same Chamfer as fits on the whole window, 15% faster).
@@ -107,6 +114,24 @@ constexpr double kFitWindow = 1.0;
 constexpr double kMinSupport = 0.5;
 constexpr double kSupportDistance = 1.5;
 constexpr double kGapClosing = 1.5;
+
+// The resolution when the caller gives none (see the header): voxels kSpacingVoxels sample
+// spacings wide, widened to kNoiseVoxels times the noise estimate, within [kAutoMin, kAutoMax].
+// Measured on the built-in knot (20k points, resolutions 128-512): clean points gain from
+// every finer grid (512: 3x better Chamfer than 256), noisy ones (0.2%) are best near 2 sigma
+// per voxel (finer grids fit the noise).
+constexpr double kSpacingVoxels = 0.25, kNoiseVoxels = 2.0;
+constexpr int kAutoMin = 64, kAutoMax = 512;
+// Levels from the data (see reconstruct_surface): a single level runs the flow on the final
+// grid (slow: 15-30 s at 256); more than three coarsen beyond what 20k points need.
+constexpr int kMinAutoLevels = 2, kMaxAutoLevels = 3;
+
+int auto_resolution(const SamplingEstimate& s, double longest, double half_width) {
+  const double h = std::max(kSpacingVoxels * s.spacing, kNoiseVoxels * s.noise);
+  const double pad = 2.0 * (half_width + 2.0);
+  if (!(h > 0.0)) return kAutoMax;
+  return int(std::clamp(std::ceil(longest / h + pad), double(kAutoMin), double(kAutoMax)));
+}
 
 double seconds_since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
 
@@ -122,12 +147,12 @@ void validate(const std::vector<Vec3d>& points, const ReconstructionOptions& o) 
   if (!std::isfinite(o.voxel_size) || !std::isfinite(o.half_width) || !std::isfinite(o.shell_offset) ||
       !std::isfinite(o.curvature_weight) || !std::isfinite(o.tolerance))
     throw Error(ErrorCode::NonFinite, "reconstruct", "non-finite option");
-  require((o.resolution > 0) != (o.voxel_size > 0.0), "give exactly one of resolution and voxel_size");
+  require(!(o.resolution > 0 && o.voxel_size > 0.0), "give at most one of resolution and voxel_size");
   require(o.resolution >= 0 && o.voxel_size >= 0.0, "resolution and voxel_size must not be negative");
   require(o.half_width >= 2.0 && o.half_width <= 8.0, "half_width must be in [2, 8] voxels");
   require(o.resolution == 0 || o.resolution >= int(2 * (o.half_width + 2)) + 8,
           "resolution " + std::to_string(o.resolution) + " is too small for the band");
-  require(o.levels >= 1 && o.levels <= 6, "levels must be in [1, 6]");
+  require(o.levels >= 0 && o.levels <= 6, "levels must be in [1, 6] (0: from the data)");
   require(o.shell_offset >= 1.0 && o.shell_offset <= 16.0, "shell_offset must be in [1, 16] voxels");
   require(o.neighbors >= 1 && o.neighbors <= 256, "neighbors must be in [1, 256]");
   require(o.curvature_weight >= 0.0, "curvature_weight must be >= 0");
@@ -451,6 +476,7 @@ std::uint64_t drop_unsupported_components(NarrowBand& band, const PointIndex& in
 struct SnapPass {
   double mean_change = 0.0;     // voxels, over the snapped voxels
   double noise = 0.0;           // mean robust spread of the fits, voxels
+  double height_noise = 0.0;    // mean residual of the height fits (noise without sagitta), voxels
   int smoothing = 0;            // extra smoothing passes of the offsets
   bool clean = false;           // the height fits' offsets were used, unaveraged
   std::uint64_t voxels = 0;     // snapped (fits computed)
@@ -458,17 +484,36 @@ struct SnapPass {
   std::uint64_t refused = 0;    // sign changes refused (not simple: they would change the topology)
 };
 
-// The height fits' point count on noisy data (see kNoisyHeightNeighbors): the density is
-// the points per final voxel^2 of front, the front's area the count of voxels within half a
-// voxel of it (a distance's slab of one voxel's thickness).
-int noisy_height_neighbors(const NarrowBand& band, std::size_t points, double h_final) {
+// The front's sampling density: points per final voxel^2 of front, the front's area the count
+// of voxels within half a voxel of it (a distance's slab of one voxel's thickness); 0 when the
+// band has no such voxel.
+double front_density(const NarrowBand& band, std::size_t points, double h_final) {
   const float half = float(0.5 * band.voxel_size());
   std::uint64_t slab = 0;
   for (const float v : band.values())
     if (std::abs(v) < half) ++slab;
-  if (slab == 0) return kNoisyHeightNeighbors;
+  if (slab == 0) return 0.0;
   const double ratio = h_final / band.voxel_size();
-  const double density = double(points) / double(slab) * ratio * ratio;
+  return double(points) / double(slab) * ratio * ratio;
+}
+
+// The height fits' point count (see kNoisyHeightNeighbors) at a density (points per final
+// voxel^2) and, on clean data, a noise (final voxels): the patch radius minimising bias ~ r^3
+// against variance ~ sigma^2 / (density r^2) goes as sigma^(1/4) density^(-1/8), so the count
+// as sigma^(1/2) density^(3/4); kNoisyHeightNeighbors at kReferenceNoise. `noise` is the
+// height fits' residual (no sagitta), counted beyond kResidualFloor. Never below
+// kHeightNeighbors (clean data: 16 measured best; 24 cost the clean blobby 20 %).
+int height_neighbors_for(double density, double noise) {
+  if (!(density > 0.0)) return kNoisyHeightNeighbors;
+  const double excess = std::sqrt(std::max(0.0, noise * noise - kResidualFloor * kResidualFloor));
+  const double k = kNoisyHeightNeighbors * std::pow(density / kReferenceDensity, kDensityExponent) *
+                   std::sqrt(excess / kReferenceNoise);
+  return int(std::clamp(std::lround(k), long(kHeightNeighbors), 256L));
+}
+
+int noisy_height_neighbors(const NarrowBand& band, std::size_t points, double h_final) {
+  const double density = front_density(band, points, h_final);
+  if (!(density > 0.0)) return kNoisyHeightNeighbors;
   const double k = kNoisyHeightNeighbors * std::pow(density / kReferenceDensity, kDensityExponent);
   return int(std::clamp(std::lround(k), long(kNoisyHeightNeighbors) / 2, 256L));
 }
@@ -500,6 +545,7 @@ SnapPass snap_to_fits(NarrowBand& band, const PointIndex& index, const SnapSetti
   std::vector<double> spread(band.brick_count(), 0.0);  // per brick: sum of the fits' spread
   std::vector<std::uint32_t> fitted(band.brick_count(), 0);
   std::vector<std::uint32_t> heights(band.brick_count(), 0);
+  std::vector<double> residual(band.brick_count(), 0.0);  // per brick: sum of the height fits' residuals
   tbb::parallel_for(tbb::blocked_range<std::uint32_t>(0, std::uint32_t(band.brick_count()), 8),
                     [&](const tbb::blocked_range<std::uint32_t>& r) {
                       progress.check("reconstruct snap");
@@ -529,6 +575,7 @@ SnapPass snap_to_fits(NarrowBand& band, const PointIndex& index, const SnapSetti
                           double second = plane;
                           if (sf.has_height && std::abs(sf.height_offset - plane) <= kHeightGuard * h) {
                             second = sf.height_offset;
+                            residual[b] += sf.height_residual;
                             ++heights[b];
                           }
                           offset[i] = float(std::clamp(plane - u, -h, h));
@@ -546,12 +593,13 @@ SnapPass snap_to_fits(NarrowBand& band, const PointIndex& index, const SnapSetti
   // (each adds ~2/3 h^2 of variance per axis, a heat-equation time of ~1/3 h^2), their
   // number set by the mean noise estimate sigma of the fits (kSmoothingGain); none on clean
   // data, where it would only blur.
-  double sigma_sum = 0.0;
+  double sigma_sum = 0.0, residual_sum = 0.0;
   std::uint64_t sigma_n = 0, height_n = 0;
   for (std::size_t b = 0; b < spread.size(); ++b) {
     sigma_sum += spread[b];
     sigma_n += fitted[b];
     height_n += heights[b];
+    residual_sum += residual[b];
   }
   const double sigma = sigma_n > 0 ? sigma_sum / double(sigma_n) / h : 0.0;
   // 2b. Clean data (see kCleanNoise): the height fits' offsets, averaged over face neighbours below.
@@ -613,6 +661,7 @@ SnapPass snap_to_fits(NarrowBand& band, const PointIndex& index, const SnapSetti
   SnapPass pass;
   pass.refused = refused;
   pass.noise = sigma;
+  pass.height_noise = height_n > 0 ? residual_sum / double(height_n) / h : 0.0;
   pass.smoothing = smoothing;
   pass.clean = clean;
   pass.height_fits = height_n;
@@ -636,7 +685,14 @@ ReconstructionResult reconstruct_surface(const std::vector<Vec3d>& input, const 
   const double longest = std::max({ext.x, ext.y, ext.z});
   require(longest > 0.0 && std::isfinite(longest), "all points are equal (or the extent is not finite)");
   const double W = o.half_width;
-  const double h_final = o.voxel_size > 0.0 ? o.voxel_size : longest / (double(o.resolution) - 2.0 * (W + 2.0));
+  std::vector<Vec3d> points(input.size());
+  for (std::size_t i = 0; i < input.size(); ++i) points[i] = input[i] - centre;
+  const PointIndex index(points);
+  ReconstructionResult result;
+  result.sampling = estimate_sampling(index, {16, 2000, o.progress});
+  result.resolution = o.resolution > 0 ? o.resolution : 0;
+  if (o.resolution == 0 && o.voxel_size <= 0.0) result.resolution = auto_resolution(result.sampling, longest, W);
+  const double h_final = o.voxel_size > 0.0 ? o.voxel_size : longest / (double(result.resolution) - 2.0 * (W + 2.0));
   const double side = longest / h_final + 2.0 * (W + 2.0);
   if (!(side <= double(o.max_resolution)))
     throw Error(ErrorCode::LimitExceeded, "reconstruct",
@@ -646,29 +702,41 @@ ReconstructionResult reconstruct_surface(const std::vector<Vec3d>& input, const 
     if (o.log) o.log(line);
   };
 
-  std::vector<Vec3d> points(input.size());
-  for (std::size_t i = 0; i < input.size(); ++i) points[i] = input[i] - centre;
+  if (o.resolution == 0 && o.voxel_size <= 0.0) {
+    char chosen[200];
+    std::snprintf(chosen, sizeof chosen, "resolution %d from the data: spacing %.4g, noise %.4g (world; %.2f and %.2f voxels)",
+                  result.resolution, result.sampling.spacing, result.sampling.noise, result.sampling.spacing / h_final,
+                  result.sampling.noise / h_final);
+    log(chosen);
+  }
   BBox local;
   local.min = box.min - centre;
   local.max = box.max - centre;
-  const PointIndex index(points);
 
-  // Fewer levels when the coarsest would have under 24 voxels along the longest side.
-  int levels = o.levels;
-  while (levels > 1 && longest / (h_final * std::ldexp(1.0, levels - 1)) < 24.0) --levels;
-  const double h_coarse = h_final * std::ldexp(1.0, levels - 1);
   // The start shell closes holes between samples up to its offset: at least kGapClosing times
   // the 90th percentile of the distance to the 8th nearest sample, or its flood fill leaks
   // into the inside and the flow collapses onto the points from both sides.
   const double gap = sample_gap(index, 8, 0.9, 4000);
+  // Levels from the data unless given: the coarsest voxel no wider than the gap the shell
+  // must close (coarser levels only close more: tunnels and gaps between nearby parts that
+  // the points resolve), within [kMinAutoLevels, kMaxAutoLevels]; fewer when the coarsest
+  // would have under 24 voxels along the longest side.
+  int levels = o.levels;
+  if (levels == 0) {
+    const double ratio = kGapClosing * gap / h_final;
+    levels = ratio >= 1.0 ? 1 + int(std::floor(std::log2(ratio))) : 1;
+    levels = std::clamp(levels, kMinAutoLevels, kMaxAutoLevels);
+  }
+  while (levels > 1 && longest / (h_final * std::ldexp(1.0, levels - 1)) < 24.0) --levels;
+  const double h_coarse = h_final * std::ldexp(1.0, levels - 1);
   const double shell_offset = std::min(16.0, std::max(o.shell_offset, kGapClosing * gap / h_coarse));
   const double pad = (shell_offset + W + 3.0) * h_coarse;
   const Vec3d origin = local.min - Vec3d{pad, pad, pad};
 
-  ReconstructionResult result;
   NarrowBand band;
   double previous_noise = 0.0;  // final voxels: the last snap pass's noise estimate
-  char line[400];
+  double previous_height_noise = 0.0;  // final voxels: its height fits' residual (no sagitta)
+  char line[512];
   for (int level = 0; level < levels; ++level) {
     const auto t_level = Clock::now();
     const double h = h_final * std::ldexp(1.0, levels - 1 - level);
@@ -798,6 +866,10 @@ ReconstructionResult reconstruct_surface(const std::vector<Vec3d>& input, const 
         if (previous_noise >= kCleanNoise) {
           settings.noisy_height = true;
           settings.height_neighbors = std::max(settings.height_neighbors, noisy_height_neighbors(band, index.size(), h_final));
+        } else if (previous_height_noise > 0.0) {  // clean so far: more points as the noise grows
+          settings.height_neighbors = std::max(settings.height_neighbors,
+                                               height_neighbors_for(front_density(band, index.size(), h_final),
+                                                                    previous_height_noise));
         }
         settings.window = refine ? kRefineWindow : kSnapWindow;
         settings.fit_window = refine ? kRefineWindow : kFitWindow;
@@ -805,6 +877,7 @@ ReconstructionResult reconstruct_surface(const std::vector<Vec3d>& input, const 
         settings.guard = o.guard_snaps;
         const SnapPass snapped = snap_to_fits(band, index, settings, coarse, coarse_curvature, o.progress);
         previous_noise = snapped.noise * h / h_final;
+        previous_height_noise = snapped.height_noise * h / h_final;
         stage.height_neighbors = settings.height_neighbors;
         if (pass == 0 && level == levels - 1 && snapped.clean) passes = std::max(passes, o.clean_final_passes);
         refine = snapped.clean;
@@ -815,6 +888,7 @@ ReconstructionResult reconstruct_surface(const std::vector<Vec3d>& input, const 
         stage.fit_voxels += snapped.voxels;
         stage.last_change = snapped.mean_change;
         stage.noise = snapped.noise;
+        stage.height_noise = snapped.height_noise;
         stage.smoothing = snapped.smoothing;
         ++stage.steps;
         // The snap moved the front by up to one voxel, so voxels up to W + 1 voxels from the
@@ -845,10 +919,10 @@ ReconstructionResult reconstruct_surface(const std::vector<Vec3d>& input, const 
     stage.active_voxels = band.active_voxel_count();
     stage.seconds = seconds_since(t_level);
     std::snprintf(line, sizeof line,
-                  "level %d: h %.4g, shell offset %.2f voxel, %s %d, change %.4f voxel, noise %.3f voxel, %s (%d points), smoothing %d, %llu voxels, %llu fits (%llu height); start %.3f s, "
+                  "level %d: h %.4g, shell offset %.2f voxel, %s %d, change %.4f voxel, noise %.3f voxel (height fits %.3f), %s (%d points), smoothing %d, %llu voxels, %llu fits (%llu height); start %.3f s, "
                   "fits %.3f s, flow %.3f s, redistance %.3f s, total %.3f s",
                   level, h, stage.shell_offset, level == 0 ? "flow steps" : "snap passes", stage.steps, stage.last_change, stage.noise,
-                  stage.second_order ? "second order" : "plane fits", stage.height_neighbors, stage.smoothing,
+                  stage.height_noise, stage.second_order ? "second order" : "plane fits", stage.height_neighbors, stage.smoothing,
                   static_cast<unsigned long long>(stage.active_voxels), static_cast<unsigned long long>(stage.fit_voxels),
                   static_cast<unsigned long long>(stage.height_fits),
                   stage.seconds_start, stage.seconds_fit, stage.seconds_flow, stage.seconds_redistance, stage.seconds);

@@ -7,7 +7,11 @@
 //   Grid. Points are shifted to their bounding-box centre (all work in float positions stays
 //   exact to ~1e-4 voxel), the final voxel size is h = L / (resolution - 2 (W + 2)) (L the
 //   longest side of the points' box: `resolution` voxels span the box padded by W + 2 on each
-//   side) or voxel_size; level l of `levels` uses h * 2^(levels - 1 - l).
+//   side) or voxel_size; level l of `levels` uses h * 2^(levels - 1 - l). With neither given,
+//   the resolution follows from the data (apps/point_sampling.hpp: spacing s, noise n): h =
+//   max(s / 4, 2 n): clean points resolve detail finer than their spacing (the fits
+//   interpolate), noisy ones get voxels no finer than twice the noise, whose fits would chase
+//   it; within [64, 512] voxels.
 //   Start (coarsest level): the offset surface {d = offset * h_c} of the unsigned
 //   distance d to the points, outer component only (flood fill from the grid's boundary over
 //   d > offset on a dense grid of the coarsest level; the cavity inside a closed shell is
@@ -18,7 +22,11 @@
 //   offset = max(shell_offset, 1.5 g / h_c), g the 90th percentile of the distance from a
 //   sample to its 8th nearest (apps/point_distance.hpp sample_gap): with fewer levels or
 //   sparser points a fixed offset leaked (the bunny at 20k-35k points, levels = 2: the flow
-//   then pulled the shell onto the points from both sides and collapsed it).
+//   then pulled the shell onto the points from both sides and collapsed it). Levels (unless
+//   given): 1 + floor(log2(1.5 g / h)) within [2, 3], the coarsest voxel no wider than the gap
+//   the shell must close, and shell_offset 1: a coarser start closed tunnels and gaps between
+//   nearby parts that the points resolve, which the topology guard then kept (CGAL's
+//   elephant at 50k points came out genus 1 instead of 3; bench_reconstruct --sweep).
 //   Coarsest level, a flow: u_t + beta |grad u| = 0 with (beta > 0 outward, H = k1 + k2)
 //     beta = -clamp(g (s - u) / h, -1, 1) - w * min(d, h) * H,   g = 3,
 //   s = the signed distance of the voxel to the surface the k nearest points sample along the
@@ -54,6 +62,9 @@
 //   3) 3x3x3 box passes (sigma in this level's voxels), and each voxel moves by the mean e of
 //   its 3x3x3 neighbourhood (tangential averaging of the fits' noise); once a level found the
 //   data noisy, the following levels take height fits over 48 (density / 0.15)^(3/4) points
+//   (clean data: over 48 (density / 0.15)^(3/4) sqrt(n / 0.7) points, at least 16, n the
+//   previous level's height-fit residual beyond 0.1 voxel in final voxels: mild noise that the
+//   plane fits' spread, which carries the sagitta, still calls clean)
 //   (density: points per final voxel^2 of front) with at most one smoothing pass instead. A
 //   voxel may change sign only next to the front and only where the flip keeps the topology
 //   (grid/topology_guard.hpp, also in the coarse flow except where no point lies within
@@ -76,7 +87,7 @@
 //   100k points: the density-sized height fits of up to 160 points are most of it).
 // Threading: TBB throughout; the result is identical for any thread count.
 // Errors (thrown): Error{InvalidArgument} for fewer than 4 points, all points equal, bad
-//   options (resolution < 2 (W + 2) + 8, both or neither of resolution / voxel_size,
+//   options (resolution < 2 (W + 2) + 8, both resolution and voxel_size,
 //   half_width not in [2, 8], levels not in [1, 6], neighbors not in [1, 256], negative
 //   curvature weight, tolerance <= 0, max_steps < 1, snap_passes or clean_final_passes not in
 //   [0, 16],
@@ -95,6 +106,7 @@
 #include <string>
 #include <vector>
 
+#include "apps/point_sampling.hpp"
 #include "core/progress.hpp"
 #include "core/vec3.hpp"
 #include "grid/narrow_band.hpp"
@@ -104,11 +116,12 @@
 namespace levelset::apps {
 
 struct ReconstructionOptions {
-  int resolution = 256;         // voxels along the longest side of the padded box, or ...
-  double voxel_size = 0.0;      // ... the final voxel size (world); exactly one of the two > 0
+  int resolution = 0;           // voxels along the longest side of the padded box, or ...
+  double voxel_size = 0.0;      // ... the final voxel size (world); at most one of the two > 0;
+                                // neither: the resolution follows from the data (see above)
   double half_width = 3.0;      // band half-width W, voxels
-  int levels = 3;               // coarse-to-fine levels (voxel size halves per level)
-  double shell_offset = 2.0;    // start shell: offset of the points in coarsest-level voxels
+  int levels = 0;               // coarse-to-fine levels (voxel size halves per level); 0: from the data
+  double shell_offset = 1.0;    // start shell: offset of the points in coarsest-level voxels (at least)
   int neighbors = 8;            // k points per local surface fit (more: smoother under noise)
   double curvature_weight = 0.3;  // w of the coarsest level's flow
   int max_steps = 120;          // coarsest level's flow
@@ -132,6 +145,7 @@ struct ReconstructionStage {
   bool converged = false;       // tolerance reached
   double last_change = 0.0;     // voxels: flow: mean front motion per step; snap: mean change
   double noise = 0.0;           // snap: the fits' mean robust spread (noise estimate), voxels
+  double height_noise = 0.0;    // snap: the height fits' mean residual (noise without the sagitta), voxels
   int smoothing = 0;            // snap: extra smoothing passes of the offsets it chose
   bool second_order = false;    // snap: clean data: the height fits' offsets, unaveraged (last pass)
   std::uint64_t height_fits = 0;  // snap: fits whose height fit was usable (all passes)
@@ -154,6 +168,8 @@ struct ReconstructionResult {
   std::vector<ReconstructionStage> stages;
   int steps = 0;                // all levels (flow steps + snap passes)
   double voxel_size = 0.0;      // final
+  int resolution = 0;           // the final grid's (given, or chosen from the data); 0 with voxel_size
+  SamplingEstimate sampling;    // the points' spacing and noise (world), measured first
   double seconds_mesh = 0.0;
   double seconds = 0.0;         // total
 };

@@ -38,7 +38,7 @@ nlohmann::json stages_json(const std::vector<apps::ReconstructionStage>& stages)
   nlohmann::json levels = nlohmann::json::array();
   for (const apps::ReconstructionStage& s : stages)
     levels.push_back({{"level", s.level},        {"voxel_size", s.voxel_size}, {"steps", s.steps}, {"shell_offset", s.shell_offset},
-                      {"converged", s.converged}, {"last_change", s.last_change}, {"noise", s.noise},
+                      {"converged", s.converged}, {"last_change", s.last_change}, {"noise", s.noise}, {"height_noise", s.height_noise},
                       {"smoothing", s.smoothing},  {"second_order", s.second_order},
                       {"height_fits", s.height_fits}, {"height_neighbors", s.height_neighbors},
                       {"refused_flips", s.refused_flips}, {"dropped_components", s.dropped_components},

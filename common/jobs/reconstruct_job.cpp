@@ -6,12 +6,14 @@
 // Every run also reports the fit: the distances from the input points to the result.
 //   input { points = FILE (.xyz .xyzn .pwn .ply)  |  sample = knot  |  sample_mesh = FILE
 //           count = 20000  noise = 0 (x the bbox diagonal)  seed = 1 }
-//   reconstruct { levels = 3  neighbors = 8  curvature_weight = 0.3  max_steps = 120
-//                 snap_passes = 1  clean_final_passes = 2  tolerance = 0.01  shell_offset = 2
+//   reconstruct { levels = 0 (from the data)  neighbors = 8  curvature_weight = 0.3  max_steps = 120
+//                 snap_passes = 1  clean_final_passes = 2  tolerance = 0.01  shell_offset = 1
 //                 guard_flow = yes  guard_snaps = yes  free_distance = 1  accuracy_samples = 100000 }
 //   (guard_*: keep the start shell's topology in the coarse flow / the snaps; free_distance:
 //   coarse voxels from the nearest sample beyond which the flow may change it)
-// The raster's resolution / voxel_size / band are the final level's.
+// The raster's resolution / voxel_size / band are the final level's; with neither resolution
+// nor voxel_size the resolution follows from the points (stats: reconstruct.resolution,
+// resolution_from_data, sampling).
 #include <functional>
 #include <memory>
 
@@ -38,11 +40,11 @@ void run_reconstruct_job(JobContext& ctx) {
   // Every option is read (and checked) before the points are read or sampled and the work
   // starts, so a bad value fails at once.
   apps::ReconstructionOptions o;
-  const JobContext::Raster r = ctx.raster(256, 3);
+  const JobContext::Raster r = ctx.raster(0, 3);  // no resolution: chosen from the points
   o.resolution = r.voxel_size > 0 ? 0 : r.resolution;
   o.voxel_size = r.voxel_size;
   o.half_width = r.band;
-  o.levels = ctx.integer(s, "levels", o.levels, 1, 6);
+  o.levels = ctx.integer(s, "levels", o.levels, 0, 6);  // 0: from the data
   o.neighbors = ctx.integer(s, "neighbors", o.neighbors, 1, 256);
   o.curvature_weight = ctx.number(s, "curvature_weight", o.curvature_weight, 0.0, 100.0);
   o.max_steps = ctx.integer(s, "max_steps", o.max_steps, 1, 100000);
@@ -91,6 +93,9 @@ void run_reconstruct_job(JobContext& ctx) {
   const apps::ReconstructionResult result = apps::reconstruct_surface(points, o);
   ctx.stats()["reconstruct"] = {{"points", points.size()},     {"voxel_size", result.voxel_size},
                                 {"steps", result.steps},       {"seconds", result.seconds},
+                                {"resolution", result.resolution},
+                                {"resolution_from_data", o.resolution == 0 && o.voxel_size <= 0.0},
+                                {"sampling", {{"spacing", result.sampling.spacing}, {"noise", result.sampling.noise}}},
                                 {"levels", stages_json(result.stages)}};
   ctx.stats()["mesh"] = measures_json(result.measures);
 

@@ -1,4 +1,4 @@
-// levelsetd reconstruct POINTS (--resolution R | --voxel-size H) -o OUT.(ply|obj|off|stl)
+// levelsetd reconstruct POINTS [--resolution R | --voxel-size H] -o OUT.(ply|obj|off|stl)
 //   [--lsg OUT.lsg] [--curvature-weight w] [...]: a watertight surface through a point cloud
 //   (apps/reconstruction.hpp). POINTS is a point cloud file (.xyz .xyzn .pwn .ply .off) or
 //   builtin:knot[:N] (N points, default 20000, sampled by area on the built-in torus knot).
@@ -58,7 +58,7 @@ int run(const ReconstructArgs& a) {
   const std::vector<Vec3d> points = load_points(a);
   const auto t1 = std::chrono::steady_clock::now();
   apps::ReconstructionOptions o = a.options;
-  o.resolution = a.voxel_size > 0.0 ? 0 : (a.resolution > 0 ? a.resolution : 256);
+  o.resolution = a.voxel_size > 0.0 ? 0 : a.resolution;  // neither: chosen from the data
   o.voxel_size = a.voxel_size;
   std::FILE* out = summary_stream(a.stats);
   o.log = [out](const std::string& line) {
@@ -81,6 +81,9 @@ int run(const ReconstructArgs& a) {
   stats.extra["levels"] = jobs::stages_json(r.stages);
   stats.extra["points"] = points.size();
   stats.extra["voxel_size"] = r.voxel_size;
+  stats.extra["resolution"] = r.resolution;
+  stats.extra["resolution_from_data"] = a.resolution == 0 && a.voxel_size <= 0.0;
+  stats.extra["sampling"] = {{"spacing", r.sampling.spacing}, {"noise", r.sampling.noise}};
   stats.extra["steps"] = r.steps;
   stats.extra["triangles"] = r.measures.faces;
   stats.extra["genus"] = r.measures.genus;
@@ -99,7 +102,7 @@ Command add_reconstruct_command(CLI::App& app, int& threads) {
   auto args = std::make_shared<ReconstructArgs>();
   CLI::App* sub = app.add_subcommand("reconstruct", "Surface from an unorganised point cloud (no normals needed)");
   sub->add_option("points", args->input, "Point cloud (.xyz .xyzn .pwn .ply .off) or builtin:knot[:N]")->required();
-  auto* res = sub->add_option("--resolution", args->resolution, "Voxels along the longest side of the padded box (default 256)")
+  auto* res = sub->add_option("--resolution", args->resolution, "Voxels along the longest side of the padded box (default: from the points' spacing and noise)")
                   ->transform(levelset::cli::in_range(16, 1 << 14));
   auto* vs = sub->add_option("--voxel-size", args->voxel_size, "Final voxel size (world units)")->transform(levelset::cli::positive());
   res->excludes(vs);

@@ -1,7 +1,8 @@
 // bench_reconstruct --sweep (issue 19): levelset's reconstruction with default options against
 // Open3D's screened Poisson on every closed, manifold mesh of CGAL's data/meshes with at least
 // 2,000 faces; points sampled by area (seeded), Gaussian noise as a fraction of the bounding-box
-// diagonal; the same points for both. Per case: Chamfer and Hausdorff (over the diagonal),
+// diagonal; the same points for both. Per case: Chamfer and Hausdorff (printed over the
+// diagonal; world units in the --jsonl records, with the diagonal),
 // watertight, genus, components (against the true mesh's), seconds. Then a summary: wins and
 // losses on Chamfer, the median ratio, topology failures both ways, time.
 // Meshes whose features are thinner than 2 voxels at the resolution are measured and marked
@@ -12,6 +13,7 @@
 //   --meshes a.off,b.off (only these)  --max-meshes N  --ours (no Poisson)  --list (the meshes
 //   and their measurements only)  --jsonl FILE (one record per case, appended)
 //   --cache DIR (Poisson's results by case, default reconstruct-sweep-cache; reused).
+//   Development: --levels L, --shell-offset S, --curvature-weight W (reconstruction options).
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -51,6 +53,9 @@ struct SweepOptions {
   std::size_t max_meshes = 0;
   bool ours_only = false, list_only = false;
   std::string jsonl, cache = "reconstruct-sweep-cache";
+  // Development switches (not the defaults' measurement): reconstruction options.
+  int levels = 0;
+  double shell_offset = 0, curvature_weight = -1;
 };
 
 template <class T>
@@ -81,6 +86,9 @@ SweepOptions parse(int argc, char** argv) {
     else if (value && arg == "--max-meshes") o.max_meshes = std::size_t(std::atol(argv[++a]));
     else if (value && arg == "--jsonl") o.jsonl = argv[++a];
     else if (value && arg == "--cache") o.cache = argv[++a];
+    else if (value && arg == "--levels") o.levels = std::atoi(argv[++a]);
+    else if (value && arg == "--shell-offset") o.shell_offset = std::atof(argv[++a]);
+    else if (value && arg == "--curvature-weight") o.curvature_weight = std::atof(argv[++a]);
     else if (arg == "--ours") o.ours_only = true;
     else if (arg == "--list") o.list_only = true;
   }
@@ -185,7 +193,7 @@ struct CaseResult {
   double noise = 0;
   unsigned seed = 0;
   bool thin = false;
-  double truth_genus = 0;
+  double truth_genus = 0, diagonal = 1;
   std::uint64_t truth_components = 0;
   Row ours, poisson;
   bool has_poisson = false;
@@ -235,7 +243,7 @@ CaseResult run_case(const SweepMesh& m, const std::vector<Vec3d>& truth_samples,
                     unsigned seed, const SweepOptions& o) {
   CaseResult c;
   c.mesh = m.name, c.points = count, c.noise = noise, c.seed = seed, c.thin = m.thin > 0.005;
-  c.truth_genus = m.measures.genus, c.truth_components = m.measures.components;
+  c.truth_genus = m.measures.genus, c.truth_components = m.measures.components, c.diagonal = m.diagonal;
   apps::SurfaceSampleOptions ps;
   ps.count = count;
   ps.noise = noise * m.diagonal;
@@ -243,6 +251,9 @@ CaseResult run_case(const SweepMesh& m, const std::vector<Vec3d>& truth_samples,
   const std::vector<Vec3d> points = apps::sample_mesh_surface(m.mesh, ps);
   apps::ReconstructionOptions ro;  // the defaults, as `levelsetd reconstruct --resolution R`
   ro.resolution = o.resolution;
+  if (o.levels > 0) ro.levels = o.levels;
+  if (o.shell_offset > 0) ro.shell_offset = o.shell_offset;
+  if (o.curvature_weight >= 0) ro.curvature_weight = o.curvature_weight;
   const auto t0 = std::chrono::steady_clock::now();
   try {
     const apps::ReconstructionResult r = apps::reconstruct_surface(points, ro);
@@ -276,15 +287,16 @@ void print_case(const CaseResult& c, const SweepOptions& o) {
     return std::string(s);
   };
   std::printf("%-24s %7zu %5.2f%% %2u%s | %9.3e %9.3e %6.3f | %9.3e %9.3e | %-14s %-14s g%g c%llu | %6.2f %6.2f\n",
-              c.mesh.c_str(), c.points, c.noise * 100, c.seed, c.thin ? "T" : " ", c.ours.chamfer, c.poisson.chamfer,
-              ratio, c.ours.hausdorff, c.poisson.hausdorff, topo(c.ours).c_str(),
+              c.mesh.c_str(), c.points, c.noise * 100, c.seed, c.thin ? "T" : " ", c.ours.chamfer / c.diagonal,
+              c.poisson.chamfer / c.diagonal, ratio, c.ours.hausdorff / c.diagonal, c.poisson.hausdorff / c.diagonal,
+              topo(c.ours).c_str(),
               c.has_poisson ? topo(c.poisson).c_str() : "-", c.truth_genus,
               static_cast<unsigned long long>(c.truth_components), c.ours.seconds, c.poisson.seconds);
   std::fflush(stdout);
   if (o.jsonl.empty()) return;
   nlohmann::json j = {{"mesh", c.mesh},   {"points", c.points}, {"noise", c.noise},
                       {"seed", c.seed},   {"thin", c.thin},     {"truth", {{"genus", c.truth_genus}, {"components", c.truth_components}}},
-                      {"ours", row_json(c.ours)}, {"resolution", o.resolution}};
+                      {"ours", row_json(c.ours)}, {"resolution", o.resolution}, {"diagonal", c.diagonal}};
   if (c.has_poisson) j["poisson"] = row_json(c.poisson);
   std::ofstream(o.jsonl, std::ios::app) << j.dump() << "\n";
 }

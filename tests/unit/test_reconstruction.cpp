@@ -322,6 +322,7 @@ TEST(Reconstruction, BadInputsGiveTypedErrors) {
   tiny.resolution = 5;
   EXPECT_EQ(code(four, tiny), ErrorCode::InvalidArgument);
   ReconstructionOptions both;
+  both.resolution = 64;
   both.voxel_size = 0.1;
   EXPECT_EQ(code(four, both), ErrorCode::InvalidArgument);
   ReconstructionOptions k;
