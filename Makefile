@@ -6,7 +6,7 @@ JOBS   ?= $(shell nproc)
 
 RUN_BUILD := build/$(PRESET)-run
 
-.PHONY: all deps deps-run configure build build-run run serve test bench fuzz clean
+.PHONY: all deps deps-run configure build build-run run serve test bench fuzz container-test fresh-run-time clean
 
 all: build
 
@@ -51,6 +51,19 @@ FUZZ_TARGET  ?= fuzz_formula
 FUZZ_SECONDS ?= 60
 fuzz: deps
 	@bash tests/fuzz/run_libfuzzer.sh $(FUZZ_TARGET) $(FUZZ_SECONDS)
+
+# The container image built from deploy/Dockerfile and run here (issue 18): dockerd on its own
+# socket, a debootstrap base from the apt mirror, health, upload, job, frames, mesh, SIGTERM,
+# restart on the volume; prints the phase timings, image size and time to ready.
+container-test:
+	@bash deploy/install-deps.sh container
+	@/usr/bin/python3 tests/container/container_test.py
+
+# `make run` timed on a fresh machine: the debootstrap base as a container with the repository
+# copied in (not part of CI).
+fresh-run-time:
+	@bash deploy/install-deps.sh container
+	@/usr/bin/python3 tests/container/fresh_run_time.py
 
 clean:
 	rm -rf build $(OUT)

@@ -25,6 +25,8 @@ BUILD_PACKAGES=(
   libcpp-httplib-dev libspdlog-dev
   # offscreen rendering (common/render): EGL surfaceless and OSMesa, GLM, JPEG / PNG frames
   libegl-dev libopengl-dev libosmesa6-dev libglm-dev libturbojpeg0-dev libpng-dev libmeshoptimizer-dev
+  # libturbojpeg0-dev's CMake package also names libjpeg.so.62 (found missing by the image build)
+  libjpeg62-turbo-dev
   # applications: kd-tree for distances to point clouds (header-only)
   libnanoflann-dev
 )
@@ -61,8 +63,9 @@ TEST_PACKAGES=(
   xvfb xauth
 )
 CONTAINER_PACKAGES=(
-  # make container-test: a local base image from the apt mirror, docker on its own socket
-  debootstrap docker.io
+  # make container-test: a local base image from the apt mirror, docker on its own socket, the
+  # test script (standard library only)
+  debootstrap docker.io python3
 )
 
 # Groups named on the command line (default: all of them).
