@@ -2,6 +2,7 @@
 // the status line (session, version, view mode, triangles, frame rate), and the panel window
 // holding the tabs.
 #include <cstdio>
+#include <functional>
 
 #include "panels.hpp"
 
@@ -32,22 +33,19 @@ void draw_panel(PanelContext& c, float height) {
   ImGui::SetNextWindowSize(ImVec2(kPanelWidth, height));
   ImGui::Begin("levelset", nullptr, ImGuiWindowFlags_NoMove | ImGuiWindowFlags_NoResize | ImGuiWindowFlags_NoCollapse);
   if (ImGui::BeginTabBar("tabs")) {
-    if (ImGui::BeginTabItem("Controls")) {
-      draw_thesis_controls(c);
-      ImGui::EndTabItem();
-    }
-    if (ImGui::BeginTabItem("Sessions")) {
-      draw_server_and_sessions(c);
-      ImGui::EndTabItem();
-    }
-    if (ImGui::BeginTabItem("Jobs")) {
-      draw_jobs_and_log(c);
-      ImGui::EndTabItem();
-    }
-    if (ImGui::BeginTabItem("View")) {
-      draw_view_controls(c);
-      ImGui::EndTabItem();
-    }
+    // Each tab's header is noted as "tab:NAME" so a script can click it.
+    const auto tab = [](const char* name, const std::function<void()>& body) {
+      const bool open = ImGui::BeginTabItem(name);
+      if (ui::registry != nullptr) ui::registry->note(std::string("tab:") + name);
+      if (open) {
+        body();
+        ImGui::EndTabItem();
+      }
+    };
+    tab("Controls", [&] { draw_thesis_controls(c); });
+    tab("Sessions", [&] { draw_server_and_sessions(c); });
+    tab("Jobs", [&] { draw_jobs_and_log(c); });
+    tab("View", [&] { draw_view_controls(c); });
     ImGui::EndTabBar();
   }
   ImGui::End();

@@ -48,6 +48,13 @@ void evolution_sections(PanelContext& c) {
   if (ui::button("Evolve")) c.a.evolve();
   ImGui::SameLine();
   if (ui::button("Stop")) c.a.stop_evolution();
+  // The shown session's running job, as in the Jobs tab (its events feed the bar).
+  for (const JobRow& j : c.s.jobs)
+    if (j.session == c.s.current && (j.state == "running" || j.state == "queued")) {
+      ImGui::SameLine();
+      ImGui::ProgressBar(float(j.fraction), ImVec2(-1, 0), (j.op + " " + j.state).c_str());
+      break;
+    }
 
   section("H  Correct distance field");
   if (ui::button("Redistance")) c.a.redistance();

@@ -42,8 +42,11 @@ void ViewLoader::update(AppState& s, int w, int h) {
   char iso[32];
   std::snprintf(iso, sizeof iso, "%.6g", double(s.iso_shown));
   const std::string key = s.current + "@" + std::to_string(s.version()) + "@" + iso;
-  if (key != mesh_key_) {
+  bool job_running = false;
+  for (const JobRow& j : s.jobs) job_running = job_running || (j.session == s.current && j.state == "running");
+  if (key != mesh_key_ || (job_running && now - polled_at_ > 0.5 && !mesh_in_flight_->load())) {
     mesh_key_ = key;
+    polled_at_ = now;
     fetch_mesh(s);
   }
   const bool overlays = p.field != 0 || p.slice != 0 || p.volume;
@@ -62,7 +65,12 @@ void ViewLoader::fetch_mesh(AppState& s) {
   const std::string path = "/api/v1/sessions/" + Api::encode(s.current) + "/mesh?format=ply&iso=" + iso;
   const std::string session = s.current, etag = etag_;
   const int version = s.version();
-  fetches_.post([this, api, path, session, etag, version] {
+  *mesh_in_flight_ = true;
+  fetches_.post([this, api, path, session, etag, version, flag = mesh_in_flight_] {
+    struct Done {  // cleared however the request ends
+      std::atomic<bool>& f;
+      ~Done() { f = false; }
+    } done{*flag};
     try {
       Api::Raw raw = api->get_raw(path, etag);
       if (raw.status == 304) {

@@ -1,12 +1,15 @@
 // ViewLoader: picks the view mode and keeps it fed. Local geometry: the surface of the shown
 // session version at the iso value (F) is fetched as PLY with its ETag (a 304 costs nothing),
-// and the band (.lsg) when an overlay needs it. Remote frames: the session's MJPEG stream.
+// and the band (.lsg) when an overlay needs it; while a job runs on the session its latest step
+// is asked for twice a second. Remote frames: the session's MJPEG stream.
 // "auto" switches to remote frames above the triangle budget, judged before downloading from
 // the band's size (active voxels / band half-width ~ surface triangles) and after it from the
 // mesh itself.
 #pragma once
 
+#include <atomic>
 #include <cstdint>
+#include <memory>
 #include <string>
 
 #include "app_state.hpp"
@@ -42,6 +45,10 @@ class ViewLoader {
   // new size opens a new stream.
   int stream_w_ = 0, stream_h_ = 0, asked_w_ = 0, asked_h_ = 0;
   double asked_since_ = 0;
+  // While a job runs on the shown session the mesh route serves its latest step (a new ETag):
+  // asked again every 0.5 s, one request at a time.
+  double polled_at_ = 0;
+  std::shared_ptr<std::atomic<bool>> mesh_in_flight_ = std::make_shared<std::atomic<bool>>(false);
 };
 
 }  // namespace levelset::gui

@@ -240,8 +240,10 @@ def sessions_with(daemon):
         "wait_surface 60", "set new_name ball", "press rename", "set snapshot_name before", "press snapshot",
         "wait_idle 30", f"dump {d}/snapshot.json",
         # G's Stop: a long evolution ends at a step boundary with the state reached.
-        # A slow outward speed: the sphere must not vanish (it would end the job) before Stop.
-        "set formula 0.001", "set steps 100000", "press evolve", "wait_running 60", "frames 20", "click Stop",
+        # An outward speed (the sphere must not vanish before Stop); while it runs the local view
+        # follows its latest steps (the mesh route's preview); Stop keeps the state reached.
+        "set formula 0.5", "set steps 100000", "press evolve", "wait_running 60", "frames 90",
+        f"dump {d}/running.json", "click Stop",
         "wait_idle 120", "wait_surface 60", f"dump {d}/stopped.json",
         "press restore", "wait_idle 30", "wait_surface 60", f"dump {d}/restored.json",
         "press redistance", "wait_idle 120", "wait_surface 60", f"dump {d}/redistanced.json",
@@ -259,6 +261,9 @@ def sessions_with(daemon):
     check(session["name"] == "ball", f"rename: {session['name']}")
     _, _, snaps = daemon.get(f"/api/v1/sessions/{sid}/snapshots")
     check([s["name"] for s in snaps["snapshots"]] == ["before"], f"snapshots: {snaps}")
+    running = load_json(os.path.join(d, "running.json"))
+    check(running["version"] == 1 and running["view"]["triangles"] > snap["view"]["triangles"],
+          f"the view did not follow the running evolution: {snap['view']['triangles']} -> {running['view']}")
     stopped = load_json(os.path.join(d, "stopped.json"))
     job = [j for j in stopped["jobs"] if j["op"] == "evolve"][0]
     _, _, job = daemon.get(f"/api/v1/jobs/{job['id']}")
