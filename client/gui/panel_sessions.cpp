@@ -53,11 +53,11 @@ void current_session(PanelContext& c) {
   ImGui::Text("shown: %s (version %d)", c.s.session.is_object() ? c.s.session.value("name", c.s.current).c_str()
                                                                  : c.s.current.c_str(), c.s.version());
   ImGui::SetNextItemWidth(200);
-  ui::text("##new_name", &p.new_name);
+  ui::text("##new_name", "new name", &p.new_name);
   ImGui::SameLine();
   if (ui::button("Rename")) c.a.rename_session();
   ImGui::SetNextItemWidth(200);
-  ui::text("##snapshot_name", &p.snapshot_name);
+  ui::text("##snapshot_name", "snapshot name", &p.snapshot_name);
   ImGui::SameLine();
   if (ui::button("Snapshot")) c.a.snapshot();
   for (const json& snap : c.s.snapshots) {
@@ -87,7 +87,7 @@ void draw_server_and_sessions(PanelContext& c) {
   current_session(c);
   ImGui::Separator();
   ImGui::Text("Job file (as levelsetctl run)");
-  ui::text("job file", &p.job_file);
+  ui::text("job file", "configs/jobs/offset_knot.conf", &p.job_file);
   if (ui::button("Run job file")) c.a.run_job_file();
 }
 

@@ -14,7 +14,7 @@ void section(const char* title) {
 void mesh_sections(PanelContext& c) {
   PanelState& p = c.s.panel;
   section("C  Load and save mesh");
-  ui::text("mesh file", &p.mesh_file);
+  ui::text("mesh file", "path of an .off .ply .obj .stl", &p.mesh_file);
   if (ui::button("Load mesh")) c.a.load_mesh();
   ImGui::SameLine();
   ImGui::TextDisabled("%s", c.s.mesh_upload.empty() ? "(not loaded)" : c.s.mesh_upload.c_str());
@@ -95,7 +95,7 @@ void display_sections(PanelContext& c) {
 void file_sections(PanelContext& c) {
   PanelState& p = c.s.panel;
   section("J  Load point cloud");
-  ui::text("points file", &p.points_file);
+  ui::text("points file", "path of an .xyz .pwn .ply", &p.points_file);
   if (ui::button("Load point cloud")) c.a.load_points();
   ImGui::SameLine();
   if (ui::button("Reconstruct")) c.a.reconstruct();

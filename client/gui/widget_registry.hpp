@@ -43,6 +43,9 @@ inline bool button(const char* label) { return noted(ImGui::Button(label), label
 inline bool checkbox(const char* label, bool* v) { return noted(ImGui::Checkbox(label, v), label); }
 inline bool radio(const char* label, int* v, int value) { return noted(ImGui::RadioButton(label, v, value), label); }
 inline bool text(const char* label, std::string* s) { return noted(ImGui::InputText(label, s), label); }
+inline bool text(const char* label, const char* hint, std::string* s) {
+  return noted(ImGui::InputTextWithHint(label, hint, s), label);
+}
 }  // namespace ui
 
 }  // namespace levelset::gui
