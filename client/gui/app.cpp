@@ -39,8 +39,11 @@ App::App(GLFWwindow* window, const Settings& settings)
   actions_.on_local_mesh = [this](TriangleMesh mesh) {
     auto shared = std::make_shared<TriangleMesh>(std::move(mesh));
     inbox_.post([this, shared](AppState& s) {
-      if (!s.current.empty()) return;  // a session is shown: its surface wins
+      // C shows the loaded mesh (as the thesis does) until B makes a session of it.
+      actions_.select_session("");
+      scene_.clear();
       s.mesh_triangles = shared->triangles.size();
+      s.mesh_version = -1;
       scene_.set_mesh(std::move(*shared));
     });
   };

@@ -27,6 +27,13 @@ void ViewLoader::update(AppState& s, int w, int h) {
   if (w != asked_w_ || h != asked_h_) asked_w_ = w, asked_h_ = h, asked_since_ = now;
   if (stream_w_ == 0 || now - asked_since_ > 0.3) stream_w_ = asked_w_, stream_h_ = asked_h_;
   remote_.show(s.remote && s.connected ? s.current : "", stream_w_, stream_h_);
+  if (s.current.empty() && !session_.empty()) {
+    // No session shown (a loaded mesh file may be): the next one shown is fetched afresh.
+    session_.clear();
+    mesh_key_.clear();
+    band_key_.clear();
+    etag_.clear();
+  }
   if (s.current != session_ && !s.current.empty()) {
     // Another session: drop the old one's geometry (a mesh file previewed before B stays until then).
     local_.clear();

@@ -251,7 +251,9 @@ def sessions_with(daemon):
         f"set points_file {POINTS}", "press load_points", "set cloud 1", "wait_idle 60", f"dump {d}/points.json",
         "press reconstruct", "wait_idle 180", "wait_surface 60", f"dump {d}/reconstructed.json",
         f"set job_file {JOB_FILE}", "set_job_overrides", "press run_job_file", "wait_idle 180", "wait_surface 60",
-        f"dump {d}/job_file.json", "press delete", "wait_idle 30", "frames 5", f"dump {d}/deleted.json"]
+        f"dump {d}/job_file.json", "press delete", "wait_idle 30", "frames 5", f"dump {d}/deleted.json",
+        # C shows a loaded mesh file in place of the session until B makes a session of it.
+        f"set mesh_file {KNOT}", "press load_mesh", "wait_idle 60", "frames 3", f"dump {d}/loaded_file.json"]
     script.remove("set_job_overrides")
     proc, d = start_gui("sessions", script, "--server", daemon.url)
     finish_gui(proc, d, timeout=280)
@@ -283,6 +285,8 @@ def sessions_with(daemon):
     check(made["session"] not in ("", sid, rec["session"]) and made["view"]["triangles"] > 0,
           f"job file: {made['session']}")
     check(any(j["op"] == "job" or j["op"] == "evolve" for j in made["jobs"] if j["mine"]), f"jobs: {made['jobs']}")
+    loaded = load_json(os.path.join(d, "loaded_file.json"))
+    check(loaded["session"] == "" and loaded["view"]["triangles"] == 4160, f"C's mesh file: {loaded['view']}")
     deleted = load_json(os.path.join(d, "deleted.json"))
     status, _, _ = daemon.get(f"/api/v1/sessions/{made['session']}")
     check(status == 404 and deleted["session"] == "", f"delete: {status}, shown {deleted['session']!r}")
