@@ -35,7 +35,7 @@ void ViewLoader::update(AppState& s, int w, int h) {
     etag_.clear();
   }
   if (s.current != session_ && !s.current.empty()) {
-    // Another session: drop the old one's geometry (a mesh file previewed before B stays until then).
+    // Another session: drop what was shown (the last session's geometry or a loaded mesh file).
     local_.clear();
     session_ = s.current;
     s.mesh_triangles = 0;
