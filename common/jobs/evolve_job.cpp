@@ -3,16 +3,21 @@
 //   evolve { speed = -sign(H)*sqrt(K+abs(K))   c = 1  eps = 0.1   constants { a = 2 }
 //            steps = 20 | time = 0.5   scheme = godunov|eno2|weno5   rk = 1|3   cfl = 0.5
 //            redistance_every = 0   drift_tolerance = 0.05   band_growth_limit = 1.5
-//            extension = no   report_every = 10 }
+//            extension = no   report_every = 10
+//            points = FILE (dist dgx dgy dgz dn: the distance to a point cloud)
+//            roi = FILE.lsg (roi: a stored level set, the thesis's region of influence) }
 // drift_tolerance and band_growth_limit keep long runs bounded (evolve/evolution.hpp); 0 turns
-// either off.
+// either off. Without points / roi the caller's (a daemon session's) are used.
 #include <algorithm>
 #include <cstdio>
 #include <map>
 
 #include "core/error.hpp"
 #include "evolve/evolution.hpp"
+#include "grid/lsg_file.hpp"
+#include "io/point_cloud_reader.hpp"
 #include "jobs/applications.hpp"
+#include "jobs/speed_fields.hpp"
 
 namespace levelset::jobs {
 
@@ -77,11 +82,17 @@ void run_evolve_job(JobContext& ctx) {
   const config::Set& input = ctx.section("input", JobContext::input_keys());
   const config::Set& s = ctx.section("evolve", {"speed", "c", "eps", "constants", "steps", "time", "scheme", "rk", "cfl",
                                                 "redistance_every", "drift_tolerance", "band_growth_limit", "extension",
-                                                "report_every"});
+                                                "report_every", "points", "roi"});
   const NarrowBand band = ctx.input_band(input);
   const MeshMeasures before = ctx.measure_band(band);
   ctx.stats()["mesh_before"] = measures_json(before);
-  const evolve::EvolutionOptions options = evolution_options_from(ctx, s);
+  evolve::EvolutionOptions options = evolution_options_from(ctx, s);
+  // Fields: files named here, else what the caller holds (a daemon session's cloud and ROI).
+  std::shared_ptr<const PointCloud> points = ctx.options().points;
+  std::shared_ptr<const NarrowBand> roi = ctx.options().roi;
+  if (ctx.has(s, "points")) points = std::make_shared<const PointCloud>(read_point_cloud(ctx.input_path(s, "points")).cloud);
+  if (ctx.has(s, "roi")) roi = std::make_shared<const NarrowBand>(load_lsg(ctx.input_path(s, "roi")).band);
+  options.fields = speed_fields(points, roi);
   const evolve::EvolutionResult result = evolve::evolve(band, options);
   ctx.stats()["evolution"] = evolution_json(result);
   ctx.log("evolved " + std::to_string(result.steps) + " steps to t = " + std::to_string(result.time) + " (" +

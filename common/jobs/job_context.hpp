@@ -52,6 +52,10 @@ struct JobOptions {
   std::uint64_t max_domain_voxels = 0;  // shapes and meshes: the grid box's voxel budget (0: the builders')
   std::function<void(const NarrowBand& band, std::string_view suffix)> band_sink;
   std::function<void(const evolve::StepInfo& step)> on_step;
+  // Fields for speed formulas (jobs/speed_fields.hpp) when the job file names none: the
+  // session's point cloud (dist, dgx..) and region of influence (roi).
+  std::shared_ptr<const PointCloud> points;
+  std::shared_ptr<const NarrowBand> roi;
 };
 
 class JobContext {

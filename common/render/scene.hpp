@@ -29,6 +29,7 @@ struct SceneData {
   TriangleMesh mesh;
   PointCloud points;
   std::shared_ptr<const NarrowBand> band;
+  std::shared_ptr<const NarrowBand> roi;  // a stored region of influence (thesis table 4.1 D, Point(ROI))
 };
 
 struct SceneOptions {

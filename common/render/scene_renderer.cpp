@@ -82,8 +82,8 @@ struct SceneRenderer::State {
   SceneData scene;
   BBox box;
   Vec3d origin;
-  Mesh mesh, cloud, field, vectors, boundary;
-  bool band_points_ready = false, curvature_ready = false, volume_ready = false;
+  Mesh mesh, cloud, field, vectors, boundary, roi;
+  bool band_points_ready = false, curvature_ready = false, volume_ready = false, roi_ready = false;
   float curvature_scale = 1;
   unsigned texture = 0;
   DenseVolume dense;  // values released after upload
@@ -91,10 +91,10 @@ struct SceneRenderer::State {
   State(const GlFunctions& g, SceneOptions o) : gl(g), options(o), framebuffer(g) {}
 
   void clear_scene() {
-    for (Mesh* m : {&mesh, &cloud, &field, &vectors, &boundary}) release(gl, *m);
+    for (Mesh* m : {&mesh, &cloud, &field, &vectors, &boundary, &roi}) release(gl, *m);
     if (texture) gl.DeleteTextures(1, &texture);
     texture = 0;
-    band_points_ready = curvature_ready = volume_ready = false;
+    band_points_ready = curvature_ready = volume_ready = roi_ready = false;
     dense = DenseVolume{};
   }
 
@@ -116,6 +116,16 @@ struct SceneRenderer::State {
     attribute(gl, boundary, 0, 3, s.boundary);
     gl.DisableVertexAttribArray(1);
     boundary.vertices = int(s.boundary.size() / 3);
+  }
+
+  void prepare_roi_points() {
+    if (roi_ready || !scene.roi) return;
+    roi_ready = true;
+    const BandPoints s = sample_band_points(*scene.roi, origin, options.max_band_points);
+    roi = make_vao(gl);
+    attribute(gl, roi, 0, 3, s.positions);
+    attribute(gl, roi, 1, 1, s.values);
+    roi.vertices = int(s.values.size());
   }
 
   void prepare_curvature() {
@@ -231,6 +241,17 @@ void SceneRenderer::State::draw(const ViewSettings& view) {
   if (view.cloud)
     draw_markers(cloud, GL_POINTS, mvp, float(view.cloud_size), -kAll, kAll, 0.0f,
                  glm::vec3(view.cloud_color[0], view.cloud_color[1], view.cloud_color[2]));
+
+  // The region of influence's points within the value range (its own colour scale).
+  if (view.roi && scene.roi) {
+    prepare_roi_points();
+    const float roi_bg = scene.roi->background();
+    const float lo = float(std::max(view.range_min, -3.0e38)), hi = float(std::min(view.range_max, 3.0e38));
+    float scale = roi_bg;
+    if (std::isfinite(view.range_min) && std::isfinite(view.range_max))
+      scale = float(std::clamp(std::max(std::abs(view.range_min), std::abs(view.range_max)), 1e-9, double(roi_bg)));
+    draw_markers(roi, GL_POINTS, mvp, 3.0f, lo, hi, scale, {});
+  }
 
   // The band's overlays.
   if (band) {

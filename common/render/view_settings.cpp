@@ -92,7 +92,7 @@ SliceAxis axis_of(const std::string& place, const json& v) {
 constexpr const char* kFlatKeys =
     "width, height, shading, moving, yaw, pitch, zoom, distance, fov, target, light, background, color, field, "
     "field_min, field_max, vectors, curvature, boundary, slice, slice_position, volume, volume_width, volume_opacity, "
-    "cloud, cloud_size, cloud_color";
+    "cloud, cloud_size, cloud_color, roi";
 
 // One setting by its flat (URL) name; `place` names it in errors.
 void set_flat(ViewSettings& view, const std::string& key, const json& v, const std::string& place) {
@@ -127,10 +127,11 @@ void set_flat(ViewSettings& view, const std::string& key, const json& v, const s
   else if (key == "cloud") view.cloud = boolean(place, v);
   else if (key == "cloud_size") view.cloud_size = number(place, v, 1, 32);
   else if (key == "cloud_color") view.cloud_color = rgb(place, v);
+  else if (key == "roi") view.roi = boolean(place, v);
   else throw Error(ErrorCode::InvalidArgument, place, std::string("unknown view setting (") + kFlatKeys + ")");
 }
 
-// A nested object ("camera", "field", "slice", "volume", "cloud"): its keys mapped to flat names.
+// A nested object ("camera", "field", "slice", "volume", "cloud", "roi"): its keys mapped to flat names.
 void set_group(ViewSettings& view, const std::string& group, const json& object) {
   for (const auto& [k, v] : object.items()) {
     const std::string place = "view." + group + "." + sanitize_utf8(k.substr(0, 40));
@@ -186,7 +187,8 @@ void merge_json(ViewSettings& view, const json& settings) {
   if (!settings.is_object()) throw Error(ErrorCode::InvalidArgument, "view", "expected an object of view settings");
   ViewSettings next = view;  // all or nothing
   for (const auto& [key, value] : settings.items()) {
-    const bool group = key == "camera" || key == "field" || key == "slice" || key == "volume" || key == "cloud";
+    const bool group =
+        key == "camera" || key == "field" || key == "slice" || key == "volume" || key == "cloud" || key == "roi";
     if (group && value.is_object()) set_group(next, key, value);
     else if (key == "camera") throw Error(ErrorCode::InvalidArgument, "view.camera", "expected an object");
     else set_flat(next, key, value, "view." + sanitize_utf8(key.substr(0, 40)));
@@ -222,7 +224,8 @@ json to_json(const ViewSettings& v) {
           {"boundary", v.boundary},
           {"slice", {{"axis", to_string(v.slice)}, {"position", v.slice_position}}},
           {"volume", {{"on", v.volume}, {"width", v.volume_width}, {"opacity", v.volume_opacity}}},
-          {"cloud", {{"on", v.cloud}, {"size", v.cloud_size}, {"color", v.cloud_color}}}};
+          {"cloud", {{"on", v.cloud}, {"size", v.cloud_size}, {"color", v.cloud_color}}},
+          {"roi", {{"on", v.roi}}}};
 }
 
 void apply_query(ViewSettings& view, const std::string& key, const std::string& value) {

@@ -19,6 +19,8 @@
 //   gradient).
 // - The point cloud (a session's reconstruction input or an attached upload; thesis table 4.1,
 //   I): shown or not, as square points `cloud_size` pixels wide in `cloud_color`.
+// - The region of influence (a stored copy of a distance field; table 4.1 D, Point(ROI)): its
+//   voxels within [range_min, range_max] as points coloured by value, like the field.
 // - Light: direction towards the light in view space (x right, y up, z towards the viewer;
 //   (0,0,1) is a headlight). Colours are linear RGB in 0..1.
 //
@@ -29,12 +31,12 @@
 //    "field": {"on": false, "min": null | number, "max": null | number}, "vectors": false,
 //    "curvature": false, "boundary": false, "slice": {"axis": "none", "position": 0.5},
 //    "volume": {"on": false, "width": 0, "opacity": 0.5},
-//    "cloud": {"on": true, "size": 2, "color": [r,g,b]}}
+//    "cloud": {"on": true, "size": 2, "color": [r,g,b]}, "roi": {"on": false}}
 // URL parameters (apply_query): width, height, shading, moving, yaw, pitch, zoom, distance, fov,
 //   target=x,y,z, light=x,y,z, background=r,g,b, color=r,g,b, field=on|off, field_min,
 //   field_max, vectors, curvature, boundary (on|off|1|0|true|false), slice=none|x|y|z,
 //   slice_position, volume=on|off, volume_width, volume_opacity, cloud=on|off, cloud_size (1..32 px),
-//   cloud_color=r,g,b.
+//   cloud_color=r,g,b, roi=on|off.
 // Errors: Error{InvalidArgument} whose place names the setting ("view.camera.pitch") and whose
 //   reason gives the accepted range; nothing is changed by a failed merge_json / apply_query.
 // Cost: trivial. Threading: plain data.
@@ -91,6 +93,7 @@ struct ViewSettings {
   bool cloud = true;
   double cloud_size = 2;  // pixels
   std::array<float, 3> cloud_color{0.55f, 0.85f, 0.45f};
+  bool roi = false;  // needs a region of influence in the scene
 };
 
 void merge_json(ViewSettings& view, const nlohmann::json& settings);

@@ -228,7 +228,7 @@ void add_session_routes(std::vector<Route>& r) {
                }});
   r.push_back({"GET", "/api/v1/sessions/{id}/stream",
                "The session rendered live as MJPEG (multipart/x-mixed-replace): a frame after every step, view or "
-               "version change, at most max_fps a second; a slow client gets the newest frame",
+               "version change, at most stream_fps a second; a slow client gets the newest frame",
                false, false, {"width", "height", "quality", "shading", "yaw", "pitch", "zoom", "slice", "volume"}, nullptr,
                {{"200", "multipart/x-mixed-replace; boundary=levelsetframe"}, {"503", "rendering is off or too many streams"}},
                stream_frames});
@@ -270,6 +270,21 @@ void add_session_routes(std::vector<Route>& r) {
                  c.res.set_header("X-Fields", fields);
                  if (q.offset + q.limit < total) c.res.set_header("X-Next-Offset", std::to_string(q.offset + q.limit));
                  c.res.set_content(*b.bytes, b.content_type);
+               }});
+  r.push_back({"GET", "/api/v1/sessions/{id}/points", "The session's point cloud, as uploaded (format: describe()'s points.format)",
+               false, false, {}, nullptr, {{"200", "the point cloud file"}, {"404", "the session has none"}},
+               [](RouteContext& c) { send_blob(c, c.service.points(c.param(1))); }});
+  // ---- region of influence (thesis table 4.1 B, D; appended: fuzz_api's seeds index routes)
+  r.push_back({"PUT", "/api/v1/sessions/{id}/roi",
+               "Store a region of influence: a copy of the session's committed band ({}) or of a snapshot "
+               "({\"snapshot\": SID}) that speed formulas read as roi and frames show with roi=on",
+               true, false, {}, kJson, {{"200", "the session"}, {"404", "unknown snapshot"}},
+               [](RouteContext& c) { c.reply(200, c.service.put_roi(c.param(1), c.body())); }});
+  r.push_back({"DELETE", "/api/v1/sessions/{id}/roi", "Remove the session's region of influence", true, false, {},
+               nullptr, {{"204", "removed"}}, [](RouteContext& c) {
+                 auto s = c.service.sessions().get(c.param(1));
+                 c.service.sessions().remove_roi(*s);
+                 c.reply(204, nullptr);
                }});
 }
 

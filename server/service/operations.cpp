@@ -73,6 +73,8 @@ jobs::JobOptions job_options(const OperationContext& ctx, std::optional<NarrowBa
   o.confine_inputs = true;
   o.progress = ctx.progress;
   o.input_band = ctx.input;
+  o.points = ctx.points;
+  o.roi = ctx.roi;
   o.max_domain_voxels = ctx.max_domain_voxels;
   o.on_step = ctx.on_step;
   if (ctx.log) o.log = [log = ctx.log](std::string_view line) { log(std::string(line)); };

@@ -25,12 +25,15 @@
 #include "core/progress.hpp"
 #include "evolve/evolution.hpp"
 #include "grid/narrow_band.hpp"
+#include "io/triangle_mesh.hpp"
 
 namespace levelset::service {
 
 struct OperationContext {
   nlohmann::json request;
   std::shared_ptr<const NarrowBand> input;           // the session's band (null: creates one)
+  std::shared_ptr<const PointCloud> points;          // the session's point cloud (speed field dist), or null
+  std::shared_ptr<const NarrowBand> roi;             // the session's region of influence (field roi), or null
   std::filesystem::path uploads_dir;                 // where upload ids resolve
   std::filesystem::path work_dir;                    // the job's own directory (log, artifacts)
   std::function<std::string(const std::string&)> session_band_path;  // csg operand {"session": id}

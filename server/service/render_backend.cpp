@@ -17,8 +17,8 @@ class GlSceneRenderer : public SceneRenderer {
   std::string name() const override { return context_->renderer_name(); }
 
   void set_scene(std::shared_ptr<const NarrowBand> band, const TriangleMesh& surface,
-                 std::shared_ptr<const PointCloud> points) override {
-    scene_.set_scene(render::SceneData{surface, points ? *points : PointCloud{}, std::move(band)});
+                 std::shared_ptr<const PointCloud> points, std::shared_ptr<const NarrowBand> roi) override {
+    scene_.set_scene(render::SceneData{surface, points ? *points : PointCloud{}, std::move(band), std::move(roi)});
   }
 
   EncodedFrame render(const nlohmann::json& view, const std::vector<std::pair<std::string, std::string>>& query, int width,

@@ -64,7 +64,7 @@ void RenderService::loop(const std::string& mode, RendererFactory factory, std::
       if (r.scene_key != scene_key) {
         // A new state: contour it once; frames of the same state reuse the upload.
         const TriangleMesh surface = r.band->active_voxel_count() > 0 ? marching_cubes(*r.band).mesh : TriangleMesh{};
-        renderer->set_scene(r.band, surface, r.points);
+        renderer->set_scene(r.band, surface, r.points, r.roi);
         scene_key = r.scene_key;
       }
       task->result.set_value(renderer->render(r.view, r.query, r.width, r.height, r.format, r.quality));

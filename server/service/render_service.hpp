@@ -41,10 +41,10 @@ class SceneRenderer {
  public:
   virtual ~SceneRenderer() = default;
   virtual std::string name() const = 0;  // the GL renderer string, for the log
-  // The scene: the band (field displays, slice, volume), its surface mesh and the session's
-  // point cloud (null: none).
+  // The scene: the band (field displays, slice, volume), its surface mesh, the session's
+  // point cloud and region of influence (null: none).
   virtual void set_scene(std::shared_ptr<const NarrowBand> band, const TriangleMesh& surface,
-                         std::shared_ptr<const PointCloud> points) = 0;
+                         std::shared_ptr<const PointCloud> points, std::shared_ptr<const NarrowBand> roi) = 0;
   // view: the session's view settings (JSON), then the request's query parameters over them
   // (key=value as in the URL); both validated here (levelset::Error naming the setting).
   virtual EncodedFrame render(const nlohmann::json& view, const std::vector<std::pair<std::string, std::string>>& query,
@@ -56,6 +56,7 @@ struct FrameRequest {
   std::string scene_key;                     // session id + state serial: scenes are reused by key
   std::shared_ptr<const NarrowBand> band;    // the state to draw
   std::shared_ptr<const PointCloud> points;  // the session's point cloud, or null
+  std::shared_ptr<const NarrowBand> roi;     // the session's region of influence, or null
   nlohmann::json view = nlohmann::json::object();
   std::vector<std::pair<std::string, std::string>> query;  // view settings from the URL
   int width = 800, height = 600;

@@ -51,13 +51,14 @@ EncodedFrame Service::frame(const std::string& session_id, const FrameRequest& s
   auto s = sessions_->get(session_id);
   FrameRequest r = settings;
   const std::uint64_t serial = s->preview_serial();
-  const std::uint64_t cloud = s->points_serial();
+  const std::uint64_t cloud = s->points_serial(), roi = s->roi_serial();
   r.band = s->preview();
   r.points = s->points();
+  r.roi = s->roi();
   r.view = s->view();
   r.scene_key = session_id + "-v" + std::to_string(s->version()) + "-p" + std::to_string(serial) + "-c" +
-                std::to_string(cloud);
-  if (state != nullptr) *state = (serial * 1000003 + s->view_serial()) * 1009 + cloud;  // = frame_state()
+                std::to_string(cloud) + "-r" + std::to_string(roi);
+  if (state != nullptr) *state = ((serial * 1000003 + s->view_serial()) * 1009 + cloud) * 1013 + roi;  // = frame_state()
   return render_->render(std::move(r), std::chrono::seconds(30));
 }
 
@@ -210,6 +211,25 @@ json Service::patch_session(const std::string& id, const json& body) {
     else attach_points(*s, body["points"].get<std::string>(), "body.points");
   }
   if (!name.empty()) sessions_->rename(*s, name);
+  return s->describe();
+}
+
+json Service::put_roi(const std::string& id, const json& body) {
+  auto s = sessions_->get(id);
+  if (!body.is_object()) throw bad_request("expected {} (the current band) or {\"snapshot\": SNAPSHOT_ID}");
+  for (const auto& [key, value] : body.items())
+    if (key != "snapshot") throw unprocessable("body." + key.substr(0, 40), "unknown field (snapshot)");
+  if (body.contains("snapshot")) {
+    if (!body["snapshot"].is_string()) throw unprocessable("body.snapshot", "expected a snapshot id");
+    const std::string sid = body["snapshot"].get<std::string>();
+    bool known = false;
+    for (const json& j : s->snapshots()) known = known || j.value("id", "") == sid;
+    if (!known || !is_valid_id(sid, 'n')) throw not_found("snapshot", sid);
+    const NarrowBand band = load_lsg(s->dir() / ("snap-" + sid + ".lsg")).band;
+    sessions_->store_roi(*s, band, {{"snapshot", sid}});
+  } else {
+    sessions_->store_roi(*s, *s->band(), {{"version", s->version()}});
+  }
   return s->describe();
 }
 

@@ -2,7 +2,9 @@
 // evolution runs, its latest preview.
 #include <cmath>
 #include <cstring>
+#include <fstream>
 #include <functional>
+#include <iterator>
 
 #include "apps/band_curvature.hpp"
 #include "core/error.hpp"
@@ -84,6 +86,22 @@ Blob Service::band(const std::string& session_id) {
   b.etag = "\"" + session_id + "-v" + std::to_string(s->version()) + "\"";
   b.content_type = "application/octet-stream";
   b.file_name = session_id + ".lsg";
+  return b;
+}
+
+Blob Service::points(const std::string& session_id) {
+  auto s = sessions_->get(session_id);
+  const json info = s->describe().value("points", json());
+  if (!info.is_object()) throw ApiError(404, "not_found", "session " + session_id + " has no point cloud");
+  const std::string file = info.value("file", "");
+  std::ifstream in(s->dir() / file, std::ios::binary);
+  if (file.empty() || file.find('/') != std::string::npos || !in)
+    throw ApiError(404, "not_found", "session " + session_id + " has no readable point cloud");
+  Blob b;
+  b.bytes = std::make_shared<const std::string>(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+  b.etag = "\"" + session_id + "-" + file + "\"";
+  b.content_type = "application/octet-stream";
+  b.file_name = session_id + "." + info.value("format", "xyz");
   return b;
 }
 

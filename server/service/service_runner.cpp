@@ -178,6 +178,10 @@ class Service::JobRun {
     OperationContext ctx;
     ctx.request = request_;
     ctx.input = input_;
+    if (session_) {  // fields for speed formulas: the session's cloud (dist, dgx..) and ROI (roi)
+      ctx.points = session_->points();
+      ctx.roi = session_->roi();
+    }
     ctx.uploads_dir = svc_.uploads_->dir();
     ctx.work_dir = work_;
     ctx.max_formula_length = svc_.config_.max_formula_length;

@@ -73,7 +73,8 @@ json Session::describe() const {
             {"history_length", meta_.value("history", json::array()).size()},
             {"snapshots", meta_.value("snapshots", json::array()).size()},
             {"running_job", running_job_.empty() ? json(nullptr) : json(running_job_)},
-            {"points", meta_.value("points", json(nullptr))}};
+            {"points", meta_.value("points", json(nullptr))},
+            {"roi", meta_.value("roi", json(nullptr))}};
   if (band_) j["band"] = summary_;
   return j;
 }
@@ -95,6 +96,21 @@ std::shared_ptr<const PointCloud> Session::points() const {
     }
   }
   return points_;
+}
+
+std::shared_ptr<const NarrowBand> Session::roi() const {
+  std::string file;
+  {
+    std::lock_guard lock(mutex_);
+    if (!meta_.contains("roi") || !meta_["roi"].is_object()) return nullptr;
+    file = meta_["roi"].value("file", "");
+  }
+  std::lock_guard lock(points_mutex_);
+  if (!roi_ || roi_file_ != file) {  // a new ROI has a new file name
+    roi_ = std::make_shared<const NarrowBand>(load_lsg(dir_ / file).band);
+    roi_file_ = file;
+  }
+  return roi_;
 }
 
 json Session::history() const {
@@ -334,6 +350,43 @@ void SessionStore::attach_points(Session& s, const fs::path& file, json info) {
   }
   s.points_serial_.fetch_add(1);
   s.events().publish("points", info);
+}
+
+json SessionStore::store_roi(Session& s, const NarrowBand& band, json info) {
+  const std::string name = "roi-" + std::to_string(s.roi_serial_.load() + 1) + "-" + now_iso().substr(0, 19) + ".lsg";
+  std::string file = name;
+  for (char& c : file)
+    if (c == ':') c = '-';
+  save_lsg(band, s.dir_ / file);
+  info["file"] = file;
+  info["active_voxels"] = band.active_voxel_count();
+  info["voxel_size"] = band.voxel_size();
+  info["time"] = now_iso();
+  {
+    std::lock_guard lock(s.mutex_);
+    const std::string old = s.meta_.contains("roi") ? s.meta_["roi"].value("file", "") : "";
+    s.meta_["roi"] = info;
+    write_meta(s);
+    std::error_code ec;
+    if (!old.empty() && old != file) fs::remove(s.dir_ / old, ec);
+  }
+  s.roi_serial_.fetch_add(1);
+  s.events().publish("roi", info);
+  return info;
+}
+
+void SessionStore::remove_roi(Session& s) {
+  {
+    std::lock_guard lock(s.mutex_);
+    if (!s.meta_.contains("roi")) return;
+    const std::string old = s.meta_["roi"].value("file", "");
+    s.meta_.erase("roi");
+    write_meta(s);
+    std::error_code ec;
+    if (!old.empty()) fs::remove(s.dir_ / old, ec);
+  }
+  s.roi_serial_.fetch_add(1);
+  s.events().publish("roi", nullptr);
 }
 
 void SessionStore::detach_points(Session& s) {

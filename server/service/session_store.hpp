@@ -55,9 +55,14 @@ class Session {
   // read on first use and kept; null when it has none. points_serial() changes with it.
   std::shared_ptr<const PointCloud> points() const;
   std::uint64_t points_serial() const { return points_serial_.load(); }
-  // Changes whenever a frame of the session would: its band state, view or point cloud.
+  // The session's region of influence (thesis table 4.1 B and D: a stored copy of a distance
+  // field that speed formulas read as `roi`), read on first use; null when it has none.
+  std::shared_ptr<const NarrowBand> roi() const;
+  std::uint64_t roi_serial() const { return roi_serial_.load(); }
+  // Changes whenever a frame of the session would: its band state, view, point cloud or ROI.
   std::uint64_t frame_state() const {
-    return (preview_serial_.load() * 1000003 + view_serial_.load()) * 1009 + points_serial_.load();
+    return ((preview_serial_.load() * 1000003 + view_serial_.load()) * 1009 + points_serial_.load()) * 1013 +
+           roi_serial_.load();
   }
   EventLog& events() { return events_; }
 
@@ -74,10 +79,12 @@ class Session {
   nlohmann::json meta_ = nlohmann::json::object();  // what session.json holds
   std::shared_ptr<const NarrowBand> band_, preview_;
   nlohmann::json summary_;  // band_summary(*band_), computed once per version (GETs are hot)
-  std::atomic<std::uint64_t> preview_serial_{0}, view_serial_{0}, points_serial_{0};
-  mutable std::mutex points_mutex_;  // reading the cloud does not hold mutex_
+  std::atomic<std::uint64_t> preview_serial_{0}, view_serial_{0}, points_serial_{0}, roi_serial_{0};
+  mutable std::mutex points_mutex_;  // reading the cloud (or the ROI) does not hold mutex_
   mutable std::shared_ptr<const PointCloud> points_;
   mutable std::string points_file_;
+  mutable std::shared_ptr<const NarrowBand> roi_;
+  mutable std::string roi_file_;
   std::string running_job_;
   EventLog events_;
 };
@@ -106,6 +113,10 @@ class SessionStore {
   // (upload id, format, point count) is what describe() shows. Publishes "points".
   void attach_points(Session& s, const std::filesystem::path& file, nlohmann::json info);
   void detach_points(Session& s);
+  // Stores `band` as the session's region of influence (roi-<serial>.lsg); `info` (what it was
+  // made from) is what describe() shows with its summary. Publishes "roi".
+  nlohmann::json store_roi(Session& s, const NarrowBand& band, nlohmann::json info);
+  void remove_roi(Session& s);
 
   nlohmann::json snapshot(Session& s, const std::string& replica, const std::string& name);
   std::uint64_t restore(Session& s, const std::string& snapshot_id);

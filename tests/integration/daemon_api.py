@@ -704,6 +704,59 @@ def test_frames():
         off.stop()
 
 
+def test_fields():
+    """Fields of speed formulas from the session (thesis table 4.1 B, J): dist from its point
+    cloud and roi from its stored region of influence; frames show the ROI's points."""
+    import math
+    d = Daemon(BIN, fresh("fields"))
+    try:
+        s = sphere_session(d, 48)
+        sid = s["id"]
+        check(d.get(f"/api/v1/sessions/{sid}/points")[0] == 404, "no cloud: 404")
+        # Without a cloud or an ROI, formulas reading them fail, naming the field.
+        for speed, field in (("dist", "dist"), ("roi", "roi")):
+            status, _, job = d.post(f"/api/v1/sessions/{sid}/jobs", {"op": "evolve", "speed": speed, "steps": 2})
+            final = d.wait_job(job["id"]) if status == 202 else job
+            check(status in (202, 422) and field in json.dumps(final), f"speed {speed} without its field: {status} {final}")
+        # dist: points on a sphere of radius 1.3 pull the unit sphere out: with speed = dist the
+        # radius follows r' = 1.3 - r, so r(3) = 1.3 - 0.3 e^-3.
+        cloud = os.path.join(SCRATCH, "fields-sphere13.xyz")
+        with open(cloud, "w") as f:
+            n = 20000
+            for i in range(n):
+                z = 1 - 2 * (i + 0.5) / n
+                r, a = math.sqrt(1 - z * z), i * 2.399963229728653
+                f.write(f"{1.3 * r * math.cos(a):.6f} {1.3 * r * math.sin(a):.6f} {1.3 * z:.6f}\n")
+        status, _, up = upload(d, cloud, "xyz")
+        check(d.json_request("PATCH", f"/api/v1/sessions/{sid}", {"points": up["id"]})[0] == 200, "attach the cloud")
+        status, _, data = d.request("GET", f"/api/v1/sessions/{sid}/points")
+        check(status == 200 and data == open(cloud, "rb").read(), "GET .../points gives the cloud back as uploaded")
+        status, _, job = d.post(f"/api/v1/sessions/{sid}/jobs", {"op": "evolve", "speed": "dist", "time": 3})
+        final = d.wait_job(job["id"])
+        check(final["state"] == "succeeded", f"evolve with dist: {final}")
+        status, _, job = d.post(f"/api/v1/sessions/{sid}/jobs", {"op": "measure"})
+        volume = d.wait_job(job["id"])["result"]["volume"]
+        radius, expected = (3 * volume / (4 * math.pi)) ** (1 / 3), 1.3 - 0.3 * math.exp(-3)
+        check(abs(radius - expected) < 0.03, f"the front follows r' = 1.3 - r: radius {radius:.4f}, expected {expected:.4f}")
+        # roi: store the current band, then a speed reading it runs; frames show its points.
+        status, _, body = d.json_request("PUT", f"/api/v1/sessions/{sid}/roi", {})
+        check(status == 200 and body["roi"]["active_voxels"] > 1000 and body["roi"]["version"] == body["version"],
+              f"PUT roi: {status} {body}")
+        status, _, job = d.post(f"/api/v1/sessions/{sid}/jobs", {"op": "evolve", "speed": "0.1 * roi", "steps": 3})
+        check(d.wait_job(job["id"])["state"] == "succeeded", "a speed reading roi runs once the session has one")
+        frame = f"/api/v1/sessions/{sid}/frame?width=160&height=120&format=png&shading=none&cloud=off"
+        check(foreground(decode(d.request("GET", frame + "&roi=on")[2])) > 500, "roi=on draws the ROI's points")
+        check(foreground(decode(d.request("GET", frame)[2])) == 0, "roi off: nothing")
+        status, _, body = d.json_request("PUT", f"/api/v1/sessions/{sid}/roi", {"snapshot": "vm-n-0000000000000000"})
+        check(status == 404, f"an unknown snapshot: {status} {body}")
+        status, _, body = d.json_request("PUT", f"/api/v1/sessions/{sid}/roi", {"band": 1})
+        check(status == 422, f"an unknown field: {status} {body}")
+        check(d.request("DELETE", f"/api/v1/sessions/{sid}/roi")[0] == 204, "DELETE roi")
+        check(d.get(f"/api/v1/sessions/{sid}")[2]["roi"] is None, "the ROI is gone")
+    finally:
+        d.stop()
+
+
 def test_concurrency():
     """64 clients creating sessions, submitting jobs, polling and holding event streams."""
     d = Daemon(BIN, fresh("concurrency"), "--max-queued-jobs", "256")

@@ -20,7 +20,7 @@ class Overlays : public test::RenderFixture {};
 
 const SceneData& sphere() { return test::sphere_scene(); }
 
-SceneData band_only(const SceneData& s) { return SceneData{{}, {}, s.band}; }
+SceneData band_only(const SceneData& s) { return SceneData{{}, {}, s.band, nullptr}; }
 
 ViewSettings front_view(int w, int h) {  // looking down -z at the scene's centre
   ViewSettings v;
@@ -67,6 +67,25 @@ TEST_P(Overlays, FieldPointsWithinTheRange) {
   EXPECT_GT(foreground(renderer->render(v)), 1000u);
   v.vectors = false, v.boundary = true;
   EXPECT_GT(foreground(renderer->render(v)), 1000u);
+}
+
+TEST_P(Overlays, RegionOfInfluencePoints) {
+  // Table 4.1 D, Point(ROI): the stored field's points, independent of the current band. The
+  // scene's band is the sphere, its ROI the knot: roi=on draws points where only the knot is.
+  SceneData scene = sphere();
+  scene.roi = test::shape_scene("knot", 48).band;
+  renderer->set_scene(scene);
+  ViewSettings v = front_view(320, 240);
+  EXPECT_EQ(foreground(renderer->render(v)), 0u);  // shading none, no overlay
+  v.roi = true;
+  const std::size_t shown = foreground(renderer->render(v));
+  EXPECT_GT(shown, 1000u);
+  v.range_min = -1e30, v.range_max = -1e29;  // no value in range
+  EXPECT_EQ(foreground(renderer->render(v)), 0u);
+  scene.roi = nullptr;  // without one, roi=on draws nothing
+  renderer->set_scene(scene);
+  v.range_min = -1e30, v.range_max = 1e30;
+  EXPECT_EQ(foreground(renderer->render(v)), 0u);
 }
 
 TEST_P(Overlays, CurvatureColoursTheSphereUniformly) {
