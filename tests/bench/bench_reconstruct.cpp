@@ -99,7 +99,6 @@ int main(int argc, char** argv) {
           const std::vector<Vec3d> points = apps::sample_mesh_surface(truth, ps);
           apps::ReconstructionOptions o;
           o.resolution = quick ? 96 : 256;
-          if (noise > 0) o.neighbors = 24;
           if (neighbors > 0) o.neighbors = neighbors;
           if (levels > 0) o.levels = levels;
           o.guard_flow = guard_flow;
