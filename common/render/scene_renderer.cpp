@@ -98,14 +98,20 @@ struct SceneRenderer::State {
     dense = DenseVolume{};
   }
 
+  // Voxel markers: position and value per band voxel.
+  Mesh value_points(const BandPoints& s) {
+    Mesh m = make_vao(gl);
+    attribute(gl, m, 0, 3, s.positions);
+    attribute(gl, m, 1, 1, s.values);
+    m.vertices = int(s.values.size());
+    return m;
+  }
+
   void prepare_band_points() {
     if (band_points_ready || !scene.band) return;
     band_points_ready = true;
     const BandPoints s = sample_band_points(*scene.band, origin, options.max_band_points);
-    field = make_vao(gl);
-    attribute(gl, field, 0, 3, s.positions);
-    attribute(gl, field, 1, 1, s.values);
-    field.vertices = int(s.values.size());
+    field = value_points(s);
     std::vector<float> line_values;
     const std::vector<float> lines = lines_of(s, line_values);
     vectors = make_vao(gl);
@@ -121,11 +127,7 @@ struct SceneRenderer::State {
   void prepare_roi_points() {
     if (roi_ready || !scene.roi) return;
     roi_ready = true;
-    const BandPoints s = sample_band_points(*scene.roi, origin, options.max_band_points);
-    roi = make_vao(gl);
-    attribute(gl, roi, 0, 3, s.positions);
-    attribute(gl, roi, 1, 1, s.values);
-    roi.vertices = int(s.values.size());
+    roi = value_points(sample_band_points(*scene.roi, origin, options.max_band_points));
   }
 
   void prepare_curvature() {

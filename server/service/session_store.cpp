@@ -375,30 +375,26 @@ json SessionStore::store_roi(Session& s, const NarrowBand& band, json info) {
   return info;
 }
 
+// Removes the attachment `key` (its metadata and its file); false when there was none.
+bool SessionStore::drop_attachment(Session& s, const char* key) {
+  std::lock_guard lock(s.mutex_);
+  if (!s.meta_.contains(key)) return false;
+  const std::string old = s.meta_[key].value("file", "");
+  s.meta_.erase(key);
+  write_meta(s);
+  std::error_code ec;
+  if (!old.empty()) fs::remove(s.dir_ / old, ec);
+  return true;
+}
+
 void SessionStore::remove_roi(Session& s) {
-  {
-    std::lock_guard lock(s.mutex_);
-    if (!s.meta_.contains("roi")) return;
-    const std::string old = s.meta_["roi"].value("file", "");
-    s.meta_.erase("roi");
-    write_meta(s);
-    std::error_code ec;
-    if (!old.empty()) fs::remove(s.dir_ / old, ec);
-  }
+  if (!drop_attachment(s, "roi")) return;
   s.roi_serial_.fetch_add(1);
   s.events().publish("roi", nullptr);
 }
 
 void SessionStore::detach_points(Session& s) {
-  {
-    std::lock_guard lock(s.mutex_);
-    if (!s.meta_.contains("points")) return;
-    const std::string old = s.meta_["points"].value("file", "");
-    s.meta_.erase("points");
-    write_meta(s);
-    std::error_code ec;
-    if (!old.empty()) fs::remove(s.dir_ / old, ec);
-  }
+  if (!drop_attachment(s, "points")) return;
   s.points_serial_.fetch_add(1);
   s.events().publish("points", nullptr);
 }

@@ -132,6 +132,7 @@ class SessionStore {
 
  private:
   void write_meta(Session& s);  // under s.mutex_
+  bool drop_attachment(Session& s, const char* key);  // the points / roi entry and its file
 
   std::filesystem::path dir_;
   SessionLimits limits_;

@@ -16,7 +16,7 @@ import threading
 import time
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from daemon_harness import Daemon, off_topology, upload  # noqa: E402
+from daemon_harness import Daemon, off_topology, upload, write_sphere_cloud  # noqa: E402
 
 BIN, SCRATCH, CGAL = sys.argv[1], sys.argv[2], sys.argv[3]
 TOKEN_RW, TOKEN_RO = "rw-token-0123456789abcdef", "ro-token-0123456789abcdef"
@@ -720,13 +720,7 @@ def test_fields():
             check(status in (202, 422) and field in json.dumps(final), f"speed {speed} without its field: {status} {final}")
         # dist: points on a sphere of radius 1.3 pull the unit sphere out: with speed = dist the
         # radius follows r' = 1.3 - r, so r(3) = 1.3 - 0.3 e^-3.
-        cloud = os.path.join(SCRATCH, "fields-sphere13.xyz")
-        with open(cloud, "w") as f:
-            n = 20000
-            for i in range(n):
-                z = 1 - 2 * (i + 0.5) / n
-                r, a = math.sqrt(1 - z * z), i * 2.399963229728653
-                f.write(f"{1.3 * r * math.cos(a):.6f} {1.3 * r * math.sin(a):.6f} {1.3 * z:.6f}\n")
+        cloud = write_sphere_cloud(os.path.join(SCRATCH, "fields-sphere13.xyz"), 20000, 1.3)
         status, _, up = upload(d, cloud, "xyz")
         check(d.json_request("PATCH", f"/api/v1/sessions/{sid}", {"points": up["id"]})[0] == 200, "attach the cloud")
         status, _, data = d.request("GET", f"/api/v1/sessions/{sid}/points")

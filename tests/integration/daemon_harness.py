@@ -138,6 +138,17 @@ def upload(daemon, path, fmt, headers=None):
                                headers={"Content-Type": "application/octet-stream", **(headers or {})})
 
 
+def write_sphere_cloud(path, count, radius=1.0):
+    """A Fibonacci sphere of `count` points (evenly spread) as an .xyz file."""
+    import math
+    with open(path, "w") as f:
+        for i in range(count):
+            z = 1 - 2 * (i + 0.5) / count
+            r, a = math.sqrt(1 - z * z), i * 2.399963229728653
+            f.write(f"{radius * r * math.cos(a):.6f} {radius * r * math.sin(a):.6f} {radius * z:.6f}\n")
+    return path
+
+
 def off_topology(text):
     """(vertices, faces, watertight, genus, components) of an ASCII OFF triangle mesh."""
     tokens = text.split()

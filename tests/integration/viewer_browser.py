@@ -18,7 +18,7 @@ from selenium.webdriver.common.by import By
 from selenium.webdriver.support.ui import WebDriverWait
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from daemon_harness import Daemon  # noqa: E402
+from daemon_harness import Daemon, write_sphere_cloud  # noqa: E402
 
 BIN, SCRATCH = sys.argv[1], sys.argv[2]
 shutil.rmtree(SCRATCH, ignore_errors=True)
@@ -86,14 +86,7 @@ try:
     check(stored["shading"] == "wireframe" and stored["cloud"]["on"] is True, f"stored view: {stored}")
     wait.until(lambda _: driver.find_element(By.ID, "stream").screenshot_as_png != shown)
     # A point cloud from this computer: uploaded, reconstructed into a session that shows it.
-    import math
-    cloud = os.path.join(SCRATCH, "ball.xyz")
-    with open(cloud, "w") as f:
-        n = 4000
-        for i in range(n):
-            z = 1 - 2 * (i + 0.5) / n
-            r, a = math.sqrt(1 - z * z), i * 2.399963229728653
-            f.write(f"{r * math.cos(a):.6f} {r * math.sin(a):.6f} {z:.6f}\n")
+    cloud = write_sphere_cloud(os.path.join(SCRATCH, "ball.xyz"), 4000)
     driver.find_element(By.ID, "file").send_keys(cloud)
     res = driver.find_element(By.ID, "upload-resolution")
     res.clear()
