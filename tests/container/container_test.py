@@ -29,7 +29,7 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, HERE)
 sys.path.insert(0, os.path.join(HERE, "..", "integration"))
 from daemon_harness import Daemon, off_topology, upload  # noqa: E402
-from docker_env import CACHE, ROOT, Dockerd, Failure, base_image, log  # noqa: E402
+from docker_env import BASE_TAG, CACHE, ROOT, Dockerd, Failure, base_image, log  # noqa: E402
 from image_check import foreground, jpeg_size, png_rgb  # noqa: E402
 from torus_points import torus_xyz  # noqa: E402
 
@@ -75,7 +75,7 @@ class Phases:
     def report(self):
         log("---- phase timings")
         for name, seconds, note in self.rows:
-            print(f"  {name:<34} {seconds:8.1f} s  {note}", flush=True)
+            print(f"  {name:<48} {seconds:8.1f} s  {note}", flush=True)
 
 
 class Run:
@@ -133,7 +133,7 @@ def build_image(dockerd, phases):
     build_log = os.path.join(CACHE, "image-build.log")
     t0 = time.monotonic()
     with open(build_log, "wb") as f:
-        r = subprocess.run([dockerd.client, "-H", dockerd.host, "build", "-f", os.path.join(ROOT, "deploy", "Dockerfile"),
+        r = subprocess.run([dockerd.client, "-H", dockerd.host, "build", "--force-rm", "-f", os.path.join(ROOT, "deploy", "Dockerfile"),
                             "--build-arg", f"BASE={base}", "-t", IMAGE, ROOT], stdout=f, stderr=subprocess.STDOUT)
     if r.returncode != 0:
         with open(build_log, "rb") as f:
@@ -149,7 +149,7 @@ def build_image(dockerd, phases):
     for binary in ("levelsetd", "levelsetctl"):
         ldd = dockerd.out("run", "--rm", "--entrypoint", "ldd", IMAGE, f"/usr/local/bin/{binary}")
         check("not found" not in ldd, f"{binary} in the image misses libraries:\n{ldd}")
-    return base, size
+    return size
 
 
 def scenario(dockerd, phases, secrets_dir):
@@ -167,6 +167,8 @@ def scenario(dockerd, phases, secrets_dir):
     status, _, api = d.get("/api/v1")
     check(status == 200 and api["limits"]["max_sessions"] == 17 and api["limits"]["max_queued_jobs"] == 9,
           f"settings from the mounted server.conf (max_sessions 17) and LEVELSET_* (max_queued_jobs 9): {api.get('limits')}")
+    uid = dockerd.out("exec", first.name, "id", "-u")
+    check(uid not in ("", "0"), f"the daemon runs as a non-root user: uid {uid!r}")
     logs = first.logs()
     check("render: egl" in logs, f"the daemon renders through EGL with no display:\n{logs[-2000:]}")
 
@@ -238,7 +240,7 @@ def scenario(dockerd, phases, secrets_dir):
 
 def main():
     phases = Phases()
-    dockerd, base, containers, volume = None, None, [f"{TAG}-a", f"{TAG}-b"], f"{TAG}-data"
+    dockerd, containers, volume = None, [f"{TAG}-a", f"{TAG}-b"], f"{TAG}-data"
     failed = None
     t_all = time.monotonic()
     with tempfile.TemporaryDirectory(prefix="levelset-container-") as secrets_dir:
@@ -256,7 +258,7 @@ def main():
             t0 = time.monotonic()
             dockerd = Dockerd()
             phases.add("dockerd start", time.monotonic() - t0)
-            base, size = build_image(dockerd, phases)
+            size = build_image(dockerd, phases)
             scenario(dockerd, phases, secrets_dir)
             log(f"image size: {size / 1e6:.0f} MB")
         except Failure as e:
@@ -269,16 +271,17 @@ def main():
                 for c in containers:
                     dockerd.run("rm", "-f", c, check=False, capture=True)
                 dockerd.run("volume", "rm", "-f", volume, check=False, capture=True)
-                for image in (IMAGE, base):
-                    if image:
-                        dockerd.run("rmi", "-f", image, check=False, capture=True)
-                left = dockerd.out("ps", "-aq", check=False) + dockerd.out("images", "-q", "--filter", "dangling=false",
-                                                                             check=False)
+                for image in (IMAGE, BASE_TAG):
+                    dockerd.run("rmi", "-f", image, check=False, capture=True)
+                dockerd.run("image", "prune", "-a", "-f", check=False, capture=True)  # the build stage's image
+                left = dockerd.out("ps", "-aq", check=False) + dockerd.out("images", "-aq", check=False)
+                phases.add("clean-up: containers, volume, images", time.monotonic() - t0)
+                t0 = time.monotonic()
                 try:
                     dockerd.stop()
                 except Failure as e:
                     failed = failed or str(e)
-                phases.add("clean-up", time.monotonic() - t0, "(containers, volume, images, dockerd)")
+                phases.add("clean-up: dockerd stopped, its data root removed", time.monotonic() - t0)
                 if left.strip():
                     failed = failed or f"left behind in dockerd: {left}"
     phases.add("total", time.monotonic() - t_all)

@@ -18,6 +18,7 @@ import time
 
 ROOT = os.path.abspath(os.path.join(os.path.dirname(__file__), "..", ".."))
 CACHE = os.path.join(ROOT, "build", "container")
+BASE_TAG = "localhost/levelset-bookworm-base:test"
 
 
 class Failure(Exception):
@@ -155,7 +156,7 @@ def base_rootfs_tar():
     return tar, time.monotonic() - t0
 
 
-def base_image(dockerd, tag="localhost/levelset-bookworm-base:test"):
+def base_image(dockerd, tag=BASE_TAG):
     """Imports the minbase tarball as TAG; returns (tag, debootstrap seconds, import seconds)."""
     tar, made = base_rootfs_tar()
     t0 = time.monotonic()

@@ -19,7 +19,7 @@ import traceback
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, HERE)
-from docker_env import ROOT, Dockerd, Failure, base_image, log  # noqa: E402
+from docker_env import BASE_TAG, ROOT, Dockerd, Failure, base_image, log  # noqa: E402
 
 NAME = f"levelset-fresh-{os.getpid()}"
 
@@ -48,7 +48,7 @@ def timed_exec(dockerd, script):
 
 
 def main():
-    dockerd, base, failed, rows = None, None, None, []
+    dockerd, failed, rows = None, None, []
     try:
         dockerd = Dockerd()
         base, made, imported = base_image(dockerd)
@@ -80,8 +80,7 @@ def main():
     finally:
         if dockerd is not None:
             dockerd.run("rm", "-f", NAME, check=False, capture=True)
-            if base:
-                dockerd.run("rmi", "-f", base, check=False, capture=True)
+            dockerd.run("rmi", "-f", BASE_TAG, check=False, capture=True)
             dockerd.stop()
     log("---- fresh machine")
     for name, seconds in rows:
