@@ -18,6 +18,7 @@ import time
 import traceback
 
 HERE = os.path.dirname(os.path.abspath(__file__))
+sys.dont_write_bytecode = True  # no __pycache__ in the source tree
 sys.path.insert(0, HERE)
 from docker_env import BASE_TAG, ROOT, Dockerd, Failure, base_image, log  # noqa: E402
 
