@@ -48,6 +48,7 @@ void Actions::connect(const std::string& server, const std::string& token) {
       c_.state.jobs.clear();
       c_.state.mesh_upload.clear();
       c_.state.points_upload.clear();
+      c_.state.before_file.clear();
     }
     c_.state.server = server;
     c_.state.token = token;
@@ -68,7 +69,7 @@ void Actions::select_session(const std::string& id) {
 }
 
 // A job was accepted: list it, follow its events, and show what it creates when it ends.
-void Actions::adopt_job(const json& job, bool select_created) {
+void Actions::adopt_job(const json& job, bool select_created, EventStreams::JobThen then) {
   JobRow row;
   row.id = job.value("id", "");
   row.op = job.value("op", "");
@@ -83,7 +84,15 @@ void Actions::adopt_job(const json& job, bool select_created) {
     if (select_created) s.select_after_job = row.id;
     s.add_log("job " + row.id + " (" + row.op + ") queued");
   });
-  c_.inbox.post([this, id = row.id](AppState&) { c_.streams.follow_job(id); });
+  c_.inbox.post([this, id = row.id, then = std::move(then)](AppState&) { c_.streams.follow_job(id, then); });
+}
+
+void Actions::show_session(const json& description, const std::string& log_line, bool select) {
+  c_.inbox.post([description, log_line, select](AppState& s) {
+    if (select) s.current = description.value("id", "");
+    if (s.current == description.value("id", "")) s.session = description;
+    if (!log_line.empty()) s.add_log(log_line);
+  });
 }
 
 void Actions::submit_job(const json& body, const std::string& what) {

@@ -49,7 +49,10 @@ class Actions {
   // Thesis table 4.1.
   void load_mesh();          // C: upload the mesh file (and show it)
   void save_mesh();          // C: download the surface at the iso value
-  void compute_distance();   // B: a session from the uploaded mesh (CPT) with the band width
+  void compute_distance();   // B: a session from the uploaded mesh (CPT) with the band width; with
+                             //    the ROI option its field becomes the shown session's region of influence
+  void store_roi();          // B: the shown session's own field becomes its region of influence
+  void clear_roi();          // B: the shown session has no region of influence any more
   void extract();            // F: show the isosurface at the entered value
   void evolve();             // G: start
   void stop_evolution();     // G: stop the running evolution, keeping the state reached
@@ -66,7 +69,10 @@ class Actions {
 
  private:
   void submit_job(const nlohmann::json& body, const std::string& what);
-  void adopt_job(const nlohmann::json& job, bool select_created);
+  void adopt_job(const nlohmann::json& job, bool select_created, EventStreams::JobThen then = {});
+  // A session's new description (from a worker thread) replaces the one shown if it is that
+  // session's, or is shown anyway with `select`.
+  void show_session(const nlohmann::json& description, const std::string& log_line, bool select = false);
   void report(const std::exception& e, const std::string& what);
   std::shared_ptr<const client::Api> api_or_complain();
   ActionContext c_;

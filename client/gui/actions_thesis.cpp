@@ -48,20 +48,69 @@ void Actions::compute_distance() {
     return;
   }
   const PanelState& p = c_.state.panel;
+  // The ROI option (thesis B): the field computed becomes the region of influence of the session
+  // shown (the surface being evolved; or the one shown before C's mesh file replaced it), which
+  // is shown again, and the session made for it is removed; with none it is the new session's own.
+  const std::string target = !p.roi ? "" : !c_.state.current.empty() ? c_.state.current : c_.state.before_file;
   json body = {{"upload", c_.state.mesh_upload},
-               {"name", fs::path(p.mesh_file).stem().string()},
+               {"name", fs::path(p.mesh_file).stem().string() + (p.roi ? " (roi)" : "")},
                {"raster", {{"resolution", p.resolution}, {"band", p.band}}}};
-  c_.commands.post([this, api, body] {
+  EventStreams::JobThen then;
+  if (p.roi) {
+    then = [this, target](const Api& a, const json& job) {
+      const json result = job.value("result", json::object());
+      const std::string made = result.is_object() ? result.value("session", "") : "";
+      if (made.empty()) throw std::runtime_error("the job made no session");
+      if (target.empty()) {
+        show_session(a.put(session_path(made) + "/roi", json::object()), "region of influence of " + made + " stored");
+        return;
+      }
+      show_session(a.put(session_path(target) + "/roi", {{"session", made}}),
+                   "region of influence of " + target + " computed from " + made, true);
+      a.del(session_path(made));
+    };
+  }
+  c_.commands.post([this, api, body, target, then] {
     try {
       int status = 0;
       const json answer = api->post("/api/v1/sessions", body, &status);
       if (status == 201) {  // made at once (a band upload)
-        c_.inbox.post([answer](AppState& s) { s.current = answer.value("id", ""), s.session = answer; });
+        if (then) then(*api, {{"result", {{"session", answer.value("id", "")}}}});
+        if (!then || target.empty())
+          c_.inbox.post([answer](AppState& s) { s.current = answer.value("id", ""), s.session = answer; });
       } else {
-        adopt_job(answer, true);
+        adopt_job(answer, target.empty(), then);
       }
     } catch (const std::exception& e) {
       report(e, "compute distance field");
+    }
+  });
+}
+
+void Actions::store_roi() {
+  auto api = api_or_complain();
+  if (!api) return;
+  if (c_.state.current.empty()) return c_.state.add_error("store region of influence: no session shown");
+  const std::string id = c_.state.current;
+  c_.commands.post([this, api, id] {
+    try {
+      show_session(api->put(session_path(id) + "/roi", json::object()), "region of influence of " + id + " stored");
+    } catch (const std::exception& e) {
+      report(e, "store region of influence");
+    }
+  });
+}
+
+void Actions::clear_roi() {
+  auto api = api_or_complain();
+  if (!api || c_.state.current.empty()) return;
+  const std::string id = c_.state.current;
+  c_.commands.post([this, api, id] {
+    try {
+      api->del(session_path(id) + "/roi");
+      show_session(api->get(session_path(id)), "region of influence of " + id + " removed");
+    } catch (const std::exception& e) {
+      report(e, "clear region of influence");
     }
   });
 }

@@ -38,18 +38,24 @@ App::App(GLFWwindow* window, const Settings& settings)
   // Files read on a worker reach the scene through the inbox (the scene is the UI thread's).
   actions_.on_local_mesh = [this](TriangleMesh mesh) {
     auto shared = std::make_shared<TriangleMesh>(std::move(mesh));
-    inbox_.post([this, shared](AppState& s) {
+    auto simplified = std::make_shared<const std::vector<std::uint32_t>>(
+        render::motion_indices(*shared, SceneView::options()));  // here, on the worker thread
+    inbox_.post([this, shared, simplified](AppState& s) {
       // C shows the loaded mesh (as the thesis does) until B makes a session of it.
+      if (!s.current.empty()) s.before_file = s.current;
       actions_.select_session("");
       scene_.clear();
       s.mesh_triangles = shared->triangles.size();
       s.mesh_version = -1;
-      scene_.set_mesh(std::move(*shared));
+      scene_.set_mesh(std::move(*shared), simplified);
     });
   };
   actions_.on_local_points = [this](PointCloud points) {
     auto shared = std::make_shared<PointCloud>(std::move(points));
-    inbox_.post([this, shared](AppState&) { scene_.set_points(std::move(*shared)); });
+    inbox_.post([this, shared](AppState& s) {
+      s.cloud_points = shared->points.size();
+      scene_.set_points(std::move(*shared));
+    });
   };
   if (!settings.server.empty()) actions_.connect(settings.server, settings.token);
 }
@@ -133,6 +139,8 @@ void App::count_fps() {
   ++frames_;
   ++fps_window_frames_;
   const double t = now_seconds();
+  if (last_frame_at_ > 0) longest_frame_ = std::max(longest_frame_, t - last_frame_at_);
+  last_frame_at_ = t;
   if (fps_window_start_ == 0) fps_window_start_ = t;
   if (t - fps_window_start_ >= 1.0) {
     state_.fps = double(fps_window_frames_) / (t - fps_window_start_);
@@ -215,11 +223,14 @@ json App::dump() const {
                              {"formula", state_.formula_error.formula}}},
           {"session", state_.current},
           {"version", state_.version()},
+          {"roi", state_.session.is_object() ? state_.session.value("roi", json()) : json()},
           {"jobs", jobs},
           {"view", {{"remote", state_.remote}, {"triangles", state_.mesh_triangles}, {"mesh_version", state_.mesh_version},
                     {"frames_received", state_.frames_received}, {"fps", state_.fps},
-                    {"band_loaded", state_.band_loaded}}},
+                    {"band_loaded", state_.band_loaded}, {"roi_loaded", state_.roi_loaded},
+                    {"cloud_points", state_.cloud_points}}},
           {"frames", frames_},
+          {"longest_frame_ms", 1000 * longest_frame_},
           {"camera", {{"yaw", camera_.camera.yaw}, {"pitch", camera_.camera.pitch}, {"zoom", camera_.camera.zoom}}},
           {"panel", panel_to_json(state_.panel)},
           {"widgets", widgets},

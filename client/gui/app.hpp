@@ -80,6 +80,7 @@ class App {
   std::shared_ptr<std::atomic<bool>> view_in_flight_ = std::make_shared<std::atomic<bool>>(false);
   std::uint64_t frames_ = 0;
   double fps_window_start_ = 0;
+  double last_frame_at_ = 0, longest_frame_ = 0;  // seconds: the UI thread's longest stall
   std::uint64_t fps_window_frames_ = 0;
 };
 

@@ -16,10 +16,11 @@ namespace levelset::gui {
 struct PanelState {
   int shading = 4;                   // A: none points wireframe flat smooth
   float band = 3;                    // B: narrow band half-width, voxels
+  bool roi = false;                  // B: the computed field becomes the shown session's region of influence
   int resolution = 96;               // B: voxels along the longest side
   std::string mesh_file;             // C: the mesh to load
   std::string save_file = "surface.ply";  // C: where "Save mesh" writes
-  int field = 0;                     // D: none points vectors curvature boundary
+  int field = 0;                     // D: none points vectors curvature boundary roi(5)
   bool whole_range = true;           // E: show every value of the band
   float range_min = -0.05f, range_max = 0.05f;  // E
   float iso = 0;                     // F
@@ -73,6 +74,7 @@ struct AppState {
   nlohmann::json snapshots = nlohmann::json::array();
   std::vector<JobRow> jobs;
   std::string mesh_upload;          // C: the uploaded mesh B computes from
+  std::string before_file;          // C: the session shown before a loaded mesh file replaced it
   std::string points_upload;        // J
   std::string select_after_job;     // a job creating a session: show that session when it ends
 
@@ -83,6 +85,8 @@ struct AppState {
   std::int64_t mesh_version = -1;   // the session version the local mesh shows
   std::uint64_t frames_received = 0;
   bool band_loaded = false;         // the band of the shown session is here (D's overlays)
+  bool roi_loaded = false;          // its region of influence is here (D's Point(ROI))
+  std::size_t cloud_points = 0;     // the point cloud shown (I), local or the session's
   double fps = 0;
   bool quit = false;
   int daemon_pid = 0;               // the embedded levelsetd (0: none)

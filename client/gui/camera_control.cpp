@@ -54,6 +54,7 @@ render::ViewSettings view_from_panel(const PanelState& p, const CameraControl& c
   v.vectors = p.field == 2;
   v.curvature = p.field == 3;
   v.boundary = p.field == 4;
+  v.roi = p.field == 5;
   if (!p.whole_range && p.range_min <= p.range_max) {
     v.range_min = p.range_min;
     v.range_max = p.range_max;

@@ -29,12 +29,12 @@ void EventStreams::watch_session(const std::string& id) {
   streams_.push_back(std::move(stream));
 }
 
-void EventStreams::follow_job(const std::string& id) {
+void EventStreams::follow_job(const std::string& id, JobThen then) {
   if (id.empty() || !followed_.insert(id).second) return;
   auto stream = std::make_unique<Stream>();
   Stream* raw = stream.get();
-  stream->thread = std::thread([this, raw, id] {
-    job_loop(*raw, id);
+  stream->thread = std::thread([this, raw, id, then = std::move(then)] {
+    job_loop(*raw, id, then);
     raw->done = true;
   });
   streams_.push_back(std::move(stream));
@@ -60,6 +60,12 @@ void EventStreams::session_loop(Stream& self, std::string id) {
       if (api) api->events(path, last_id, [&](const client::SseEvent& e) {
         if (!e.id.empty()) last_id = e.id;
         json data = json::parse(e.data, nullptr, false);
+        if (e.type == "roi" && (data.is_object() || data.is_null())) {  // stored or removed
+          inbox_.post([id, data](AppState& s) {
+            if (s.current == id && s.session.is_object()) s.session["roi"] = data;
+          });
+          return !self.stop;
+        }
         if (!data.is_object()) return !self.stop;
         inbox_.post([id, type = e.type, data](AppState& s) {
           if (s.current != id) return;
@@ -110,7 +116,7 @@ void apply_job_end(AppState& s, const std::string& id, const json& job, const js
 
 }  // namespace
 
-void EventStreams::job_loop(Stream& self, std::string id) {
+void EventStreams::job_loop(Stream& self, std::string id, const JobThen& then) {
   client::FollowCallbacks cb;
   cb.stop = &self.stop;
   cb.reconnect_seconds = 1e9;  // the connection monitor shows the banner; keep trying
@@ -129,6 +135,13 @@ void EventStreams::job_loop(Stream& self, std::string id) {
     if (!api) return;
     const json job = client::follow_job(*api, id, cb);
     if (job.is_null()) return;
+    if (then && job.value("state", "") == "succeeded") {
+      try {
+        then(*api, job);
+      } catch (const std::exception& e) {
+        inbox_.post([id, why = describe_error(e)](AppState& s) { s.add_error("after job " + id + ": " + why); });
+      }
+    }
     // The session the job changed or made, read now: the job's end and the version it made reach
     // the window together (the session's own stream may deliver the version a moment later).
     json session;

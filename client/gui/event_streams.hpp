@@ -6,6 +6,7 @@
 #pragma once
 
 #include <atomic>
+#include <functional>
 #include <memory>
 #include <set>
 #include <string>
@@ -22,7 +23,10 @@ class EventStreams {
   ~EventStreams();  // stops every stream and joins (each notices within about a second)
 
   void watch_session(const std::string& id);  // "" for none
-  void follow_job(const std::string& id);     // once per job id
+  // Runs on the job's stream thread once the job has succeeded, before its end reaches the
+  // window (a follow-up request, e.g. storing the field it made as a region of influence).
+  using JobThen = std::function<void(const client::Api& api, const nlohmann::json& job)>;
+  void follow_job(const std::string& id, JobThen then = {});  // once per job id
   void reap();                                // joins the streams that have ended
 
  private:
@@ -31,7 +35,7 @@ class EventStreams {
     std::thread thread;
   };
   void session_loop(Stream& self, std::string id);
-  void job_loop(Stream& self, std::string id);
+  void job_loop(Stream& self, std::string id, const JobThen& then);
   const ApiHolder& api_;
   Inbox& inbox_;
   std::vector<std::unique_ptr<Stream>> streams_;

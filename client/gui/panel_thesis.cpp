@@ -24,9 +24,25 @@ void mesh_sections(PanelContext& c) {
   section("B  Compute distance field");
   ImGui::SliderFloat("band width (voxels)", &p.band, 1.0f, 10.0f, "%.1f");
   ImGui::SliderInt("resolution", &p.resolution, 16, 512);
+  ui::checkbox("ROI", &p.roi);
+  ImGui::SameLine();
+  ImGui::TextDisabled(p.roi ? "(the field becomes the shown session's roi)" : "(store the field for formulas' roi)");
   if (ui::button("Compute distance field")) c.a.compute_distance();
   ImGui::SameLine();
   ImGui::TextDisabled("(closest point transform)");
+  // The shown session's region of influence: what formulas read as roi.
+  const nlohmann::json& roi = c.s.session.is_object() ? c.s.session.value("roi", nlohmann::json()) : nlohmann::json();
+  if (ui::button("Store field as ROI")) c.a.store_roi();
+  ImGui::SameLine();
+  if (ui::button("Clear ROI")) c.a.clear_roi();
+  if (roi.is_object()) {
+    const std::string from = roi.contains("session") ? "session " + roi.value("session", "")
+                             : roi.contains("snapshot") ? "snapshot " + roi.value("snapshot", "")
+                                                        : "version " + std::to_string(roi.value("version", 0));
+    ImGui::TextDisabled("roi: %s, %llu voxels", from.c_str(), (unsigned long long)roi.value("active_voxels", 0ull));
+  } else {
+    ImGui::TextDisabled("roi: none");
+  }
 }
 
 void evolution_sections(PanelContext& c) {
@@ -75,10 +91,13 @@ void display_sections(PanelContext& c) {
     ui::radio(shadings[i], &p.shading, i);
   }
   section("D  Distance field shading");
-  const char* fields[] = {"none##field", "points##field", "vectors", "curvature", "boundary"};
-  for (int i = 0; i < 5; ++i) {
-    if (i > 0) ImGui::SameLine();
-    ui::radio(fields[i], &p.field, i);
+  // Thesis order: None, Point, Distance (vectors), Curve, Point(ROI), Boundary (PanelState::field's
+  // numbers keep the order they were added in: ROI is 5).
+  const char* fields[] = {"none##field", "points##field", "vectors", "curvature", "ROI##field", "boundary"};
+  const int values[] = {0, 1, 2, 3, 5, 4};
+  for (int i = 0; i < 6; ++i) {
+    if (i > 0 && i != 4) ImGui::SameLine();  // two rows: the panel is 420 px wide
+    ui::radio(fields[i], &p.field, values[i]);
   }
   section("E  Show range");
   ui::checkbox("whole band", &p.whole_range);

@@ -3,12 +3,16 @@
 namespace levelset::gui {
 
 SceneView::SceneView(const render::GlFunctions& gl)
-    : gl_(gl), renderer_(std::make_unique<render::SceneRenderer>(gl)) {}
+    : gl_(gl), renderer_(std::make_unique<render::SceneRenderer>(gl, options())) {}
 
 SceneView::~SceneView() = default;
 
-void SceneView::set_mesh(TriangleMesh mesh) {
+void SceneView::set_mesh(TriangleMesh mesh, std::shared_ptr<const std::vector<std::uint32_t>> simplified) {
   scene_.mesh = std::move(mesh);
+  // Kept with the mesh: a later part (band, points, ROI) re-uploads without simplifying again.
+  scene_.simplified = simplified ? std::move(simplified)
+                                 : std::make_shared<const std::vector<std::uint32_t>>(
+                                       render::motion_indices(scene_.mesh, options()));
   dirty_ = true;
 }
 
@@ -19,6 +23,11 @@ void SceneView::set_band(std::shared_ptr<const NarrowBand> band) {
 
 void SceneView::set_points(PointCloud points) {
   scene_.points = std::move(points);
+  dirty_ = true;
+}
+
+void SceneView::set_roi(std::shared_ptr<const NarrowBand> roi) {
+  scene_.roi = std::move(roi);
   dirty_ = true;
 }
 

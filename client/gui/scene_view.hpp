@@ -16,9 +16,13 @@ class SceneView {
   explicit SceneView(const render::GlFunctions& gl);  // the window's context is current
   ~SceneView();
 
-  void set_mesh(TriangleMesh mesh);
+  // `simplified`: render::motion_indices(mesh, options()) made off the UI thread, or null (then
+  // the next draw makes it, about 0.35 s per million triangles above the budget).
+  void set_mesh(TriangleMesh mesh, std::shared_ptr<const std::vector<std::uint32_t>> simplified = nullptr);
+  static render::SceneOptions options() { return {}; }
   void set_band(std::shared_ptr<const NarrowBand> band);
   void set_points(PointCloud points);
+  void set_roi(std::shared_ptr<const NarrowBand> roi);  // null: none
   void clear();
   std::size_t triangles() const { return scene_.mesh.triangles.size(); }
   bool has_band() const { return scene_.band != nullptr; }

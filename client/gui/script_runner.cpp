@@ -177,7 +177,8 @@ ScriptRunner::Step ScriptRunner::press(const std::string& action, App& app) {
       {"save_mesh", &Actions::save_mesh},     {"load_points", &Actions::load_points},
       {"reconstruct", &Actions::reconstruct}, {"screenshot", &Actions::request_screenshot},
       {"quit", &Actions::quit},               {"create_primitive", &Actions::create_primitive},
-      {"snapshot", &Actions::snapshot},       {"run_job_file", &Actions::run_job_file}};
+      {"snapshot", &Actions::snapshot},       {"run_job_file", &Actions::run_job_file},
+      {"store_roi", &Actions::store_roi},     {"clear_roi", &Actions::clear_roi}};
   if (action == "rename") return a.rename_session(), Step::Done;
   if (action == "delete") return a.delete_session(app.state().current), Step::Done;
   if (action == "restore") {

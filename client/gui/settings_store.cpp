@@ -22,7 +22,7 @@ std::string default_settings_path() {
 
 // One list of the panel's fields for both directions.
 #define LEVELSET_PANEL_FIELDS(X)                                                                     \
-  X(shading) X(band) X(resolution) X(mesh_file) X(save_file) X(field) X(whole_range) X(range_min)    \
+  X(shading) X(band) X(roi) X(resolution) X(mesh_file) X(save_file) X(field) X(whole_range) X(range_min)    \
   X(range_max) X(iso) X(formula) X(use_time) X(steps) X(time) X(scheme) X(cloud) X(cloud_size)       \
   X(points_file) X(screenshot_file) X(slice) X(slice_position) X(volume) X(view_mode)                \
   X(triangle_budget) X(primitive) X(job_file) X(new_name) X(snapshot_name)

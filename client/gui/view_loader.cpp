@@ -5,6 +5,7 @@
 
 #include "grid/lsg_file.hpp"
 #include "io/mesh_reader.hpp"
+#include "io/point_cloud_reader.hpp"
 
 namespace levelset::gui {
 
@@ -32,6 +33,8 @@ void ViewLoader::update(AppState& s, int w, int h) {
     session_.clear();
     mesh_key_.clear();
     band_key_.clear();
+    roi_key_.clear();
+    points_key_.clear();
     etag_.clear();
   }
   if (s.current != session_ && !s.current.empty()) {
@@ -41,8 +44,12 @@ void ViewLoader::update(AppState& s, int w, int h) {
     s.mesh_triangles = 0;
     s.mesh_version = -1;
     s.band_loaded = false;
+    s.roi_loaded = false;
+    s.cloud_points = 0;
     mesh_key_.clear();
     band_key_.clear();
+    roi_key_.clear();
+    points_key_.clear();
     etag_.clear();
   }
   if (s.remote || s.current.empty() || s.version() <= 0 || !s.connected) return;
@@ -62,6 +69,68 @@ void ViewLoader::update(AppState& s, int w, int h) {
     band_key_ = band_key;
     fetch_band(s);
   }
+  update_attachments(s);
+}
+
+// The region of influence and the point cloud: fetched when shown and changed (a new ROI has a
+// new file; a new cloud a new upload), dropped when the session no longer has one.
+void ViewLoader::update_attachments(AppState& s) {
+  const PanelState& p = s.panel;
+  const nlohmann::json none;
+  const nlohmann::json& roi = s.session.is_object() && s.session.contains("roi") ? s.session["roi"] : none;
+  if (p.field == 5 && roi.is_object()) {
+    const std::string key = s.current + roi.dump();
+    if (key != roi_key_) {
+      roi_key_ = key;
+      fetch_part(s, "/roi", "region of influence", [this](const std::string& body) -> Decoded {
+        auto band = std::make_shared<const NarrowBand>(decode_lsg(body, "roi.lsg").band);
+        return [this, band](AppState& st) { local_.set_roi(band), st.roi_loaded = true; };
+      });
+    }
+  } else if (!roi_key_.empty() && !roi.is_object()) {
+    roi_key_.clear();
+    local_.set_roi(nullptr);
+    s.roi_loaded = false;
+  }
+  const nlohmann::json& points = s.session.is_object() && s.session.contains("points") ? s.session["points"] : none;
+  if (p.cloud == 1 && points.is_object()) {
+    const std::string key = s.current + points.dump();
+    if (key != points_key_) {
+      points_key_ = key;
+      const std::string name = "points." + points.value("format", std::string("xyz"));
+      fetch_part(s, "/points", "point cloud", [this, name](const std::string& body) -> Decoded {
+        auto cloud = std::make_shared<PointCloud>(read_point_cloud_from_memory(body, name).cloud);
+        return [this, cloud](AppState& st) {
+          st.cloud_points = cloud->points.size();
+          local_.set_points(std::move(*cloud));
+        };
+      });
+    }
+  } else if (!points_key_.empty() && !points.is_object()) {
+    points_key_.clear();
+    local_.set_points(PointCloud{});
+    s.cloud_points = 0;
+  }
+}
+
+void ViewLoader::fetch_part(AppState& s, const std::string& path, const std::string& what,
+                            std::function<Decoded(const std::string& body)> decode) {
+  auto api = api_.get();
+  if (!api) return;
+  const std::string session = s.current;
+  fetches_.post([this, api, session, path, what, decode] {
+    try {
+      Api::Raw raw = api->get_raw("/api/v1/sessions/" + Api::encode(session) + path);
+      Decoded apply = decode(raw.body);
+      inbox_.post([session, apply](AppState& st) {
+        if (st.current == session) apply(st);
+      });
+    } catch (const std::exception& e) {
+      inbox_.post([session, what, why = describe_error(e)](AppState& st) {
+        if (st.current == session) st.add_error(what + " of " + session + ": " + why);
+      });
+    }
+  });
 }
 
 void ViewLoader::fetch_mesh(AppState& s) {
@@ -87,12 +156,15 @@ void ViewLoader::fetch_mesh(AppState& s) {
         return;
       }
       auto mesh = std::make_shared<TriangleMesh>(read_mesh_from_memory(raw.body, "mesh.ply").mesh);
-      inbox_.post([this, session, version, mesh, tag = raw.etag](AppState& st) {
+      // The moving view's simplified copy, made here rather than on the UI thread.
+      auto simplified = std::make_shared<const std::vector<std::uint32_t>>(
+          render::motion_indices(*mesh, SceneView::options()));
+      inbox_.post([this, session, version, mesh, simplified, tag = raw.etag](AppState& st) {
         if (st.current != session) return;
         etag_ = tag;
         st.mesh_triangles = mesh->triangles.size();
         st.mesh_version = version;
-        local_.set_mesh(std::move(*mesh));
+        local_.set_mesh(std::move(*mesh), simplified);
       });
     } catch (const std::exception& e) {
       inbox_.post([session, why = describe_error(e)](AppState& st) {
@@ -103,21 +175,9 @@ void ViewLoader::fetch_mesh(AppState& s) {
 }
 
 void ViewLoader::fetch_band(AppState& s) {
-  auto api = api_.get();
-  if (!api) return;
-  const std::string session = s.current;
-  fetches_.post([this, api, session] {
-    try {
-      Api::Raw raw = api->get_raw("/api/v1/sessions/" + Api::encode(session) + "/band");
-      auto band = std::make_shared<const NarrowBand>(decode_lsg(raw.body, "band.lsg").band);
-      inbox_.post([this, session, band](AppState& st) {
-        if (st.current != session) return;
-        local_.set_band(band);
-        st.band_loaded = true;
-      });
-    } catch (const std::exception& e) {
-      inbox_.post([session, why = describe_error(e)](AppState& st) { st.add_error("band of " + session + ": " + why); });
-    }
+  fetch_part(s, "/band", "band", [this](const std::string& body) -> Decoded {
+    auto band = std::make_shared<const NarrowBand>(decode_lsg(body, "band.lsg").band);
+    return [this, band](AppState& st) { local_.set_band(band), st.band_loaded = true; };
   });
 }
 

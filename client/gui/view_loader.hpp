@@ -4,11 +4,13 @@
 // is asked for twice a second. Remote frames: the session's MJPEG stream.
 // "auto" switches to remote frames above the triangle budget, judged before downloading from
 // the band's size (active voxels / band half-width ~ surface triangles) and after it from the
-// mesh itself.
+// mesh itself. The session's attachments follow its description: its region of influence
+// (.lsg) while D shows Point(ROI), and its point cloud (as uploaded) while I shows points.
 #pragma once
 
 #include <atomic>
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <string>
 
@@ -28,11 +30,17 @@ class ViewLoader {
 
   // UI thread, once a frame; w x h is the scene's size in pixels.
   void update(AppState& s, int w, int h);
-  void refetch() { mesh_key_.clear(), band_key_.clear(); }
+  void refetch() { mesh_key_.clear(), band_key_.clear(), roi_key_.clear(), points_key_.clear(); }
 
  private:
   void fetch_mesh(AppState& s);
   void fetch_band(AppState& s);
+  void update_attachments(AppState& s);
+  // GET path of the shown session on the fetch thread; `decode` (on that thread) turns the body
+  // into what the UI thread applies if the session is still shown.
+  using Decoded = std::function<void(AppState&)>;
+  void fetch_part(AppState& s, const std::string& path, const std::string& what,
+                  std::function<Decoded(const std::string& body)> decode);
   const ApiHolder& api_;
   Inbox& inbox_;
   Worker& fetches_;
@@ -40,6 +48,7 @@ class ViewLoader {
   RemoteView& remote_;
   std::string session_;            // the session the local scene belongs to
   std::string mesh_key_, band_key_;  // what was last asked for: session@version@iso
+  std::string roi_key_, points_key_;  // session + the attachment's description
   std::string etag_;
   // The frame stream's size follows the window only once a resize has settled (0.3 s): each
   // new size opens a new stream.

@@ -15,7 +15,36 @@ BBox scene_bounds(const SceneData& scene) {
   return box;
 }
 
-MeshArrays prepare_mesh(const TriangleMesh& mesh, const Vec3d& origin, const SceneOptions& options) {
+namespace {
+
+// meshoptimizer's simplification of an index list over float xyz positions (see the header).
+std::vector<std::uint32_t> simplify(const std::vector<std::uint32_t>& indices, const std::vector<float>& positions,
+                                    const SceneOptions& options) {
+  const std::size_t triangles = indices.size() / 3;
+  if (triangles <= options.moving_triangle_budget || options.moving_triangle_budget == 0) return {};
+  const std::size_t target = options.moving_triangle_budget * 3, nv = positions.size() / 3;
+  std::vector<std::uint32_t> out(indices.size());
+  std::size_t n = meshopt_simplify(out.data(), indices.data(), indices.size(), positions.data(), nv, 3 * sizeof(float),
+                                   target, options.simplify_error, 0, nullptr);
+  if (n > target)
+    n = meshopt_simplifySloppy(out.data(), indices.data(), indices.size(), positions.data(), nv, 3 * sizeof(float),
+                               target, 1.0f, nullptr);
+  out.resize(n);
+  return out;
+}
+
+}  // namespace
+
+std::vector<std::uint32_t> motion_indices(const TriangleMesh& mesh, const SceneOptions& options) {
+  if (mesh.triangles.size() <= options.moving_triangle_budget || options.moving_triangle_budget == 0) return {};
+  BBox box;
+  for (const Vec3d& v : mesh.vertices) box.extend(v);
+  const MeshArrays a = prepare_mesh(mesh, box.empty() ? Vec3d{} : box.center(), options, nullptr);
+  return a.simplified;
+}
+
+MeshArrays prepare_mesh(const TriangleMesh& mesh, const Vec3d& origin, const SceneOptions& options,
+                        const std::vector<std::uint32_t>* simplified) {
   MeshArrays a;
   const std::size_t nv = mesh.vertices.size();
   a.positions.resize(nv * 3);
@@ -37,16 +66,12 @@ MeshArrays prepare_mesh(const TriangleMesh& mesh, const Vec3d& origin, const Sce
       a.indices.push_back(v);
     }
   }
-  const std::size_t triangles = mesh.triangles.size();
-  if (triangles > options.moving_triangle_budget && options.moving_triangle_budget > 0) {
-    const std::size_t target = options.moving_triangle_budget * 3;
-    a.simplified.resize(a.indices.size());
-    std::size_t n = meshopt_simplify(a.simplified.data(), a.indices.data(), a.indices.size(), a.positions.data(), nv,
-                                     3 * sizeof(float), target, options.simplify_error, 0, nullptr);
-    if (n > target)
-      n = meshopt_simplifySloppy(a.simplified.data(), a.indices.data(), a.indices.size(), a.positions.data(), nv,
-                                 3 * sizeof(float), target, 1.0f, nullptr);
-    a.simplified.resize(n);
+  if (simplified != nullptr) {
+    for (std::uint32_t v : *simplified)
+      if (v >= nv) throw Error(ErrorCode::InvalidArgument, "simplified mesh", "vertex index out of range");
+    a.simplified = *simplified;
+  } else {
+    a.simplified = simplify(a.indices, a.positions, options);
   }
   return a;
 }

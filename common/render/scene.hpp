@@ -7,6 +7,8 @@
 //   list and, above options.moving_triangle_budget triangles, a simplified index list over the
 //   same vertices (meshoptimizer: meshopt_simplify with relative error simplify_error, then
 //   meshopt_simplifySloppy when that cannot reach the budget) drawn while the view is moving.
+// motion_indices: that simplified index list alone (empty within the budget), for a caller that
+//   makes it off its drawing thread (SceneData::simplified) so that set_scene does not.
 // scene_bounds: the box the camera fits: the mesh and the points; the band's active box only
 //   when both are empty.
 // Cost: prepare_mesh O(triangles), plus the simplification (~1 s for 1M triangles) when above
@@ -30,6 +32,9 @@ struct SceneData {
   PointCloud points;
   std::shared_ptr<const NarrowBand> band;
   std::shared_ptr<const NarrowBand> roi;  // a stored region of influence (thesis table 4.1 D, Point(ROI))
+  // The mesh's simplified copy for moving views, made beforehand by motion_indices with the
+  // renderer's options; null: set_scene makes it.
+  std::shared_ptr<const std::vector<std::uint32_t>> simplified;
 };
 
 struct SceneOptions {
@@ -46,6 +51,9 @@ struct MeshArrays {
 };
 
 BBox scene_bounds(const SceneData& scene);
-MeshArrays prepare_mesh(const TriangleMesh& mesh, const Vec3d& origin, const SceneOptions& options);
+// `simplified`: motion_indices(mesh, options) made beforehand, or null to make it here.
+MeshArrays prepare_mesh(const TriangleMesh& mesh, const Vec3d& origin, const SceneOptions& options,
+                        const std::vector<std::uint32_t>* simplified = nullptr);
+std::vector<std::uint32_t> motion_indices(const TriangleMesh& mesh, const SceneOptions& options);
 
 }  // namespace levelset::render

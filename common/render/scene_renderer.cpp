@@ -336,7 +336,7 @@ void SceneRenderer::set_scene(SceneData scene) {
   s.box = scene_bounds(s.scene);
   s.origin = s.box.empty() ? Vec3d{} : s.box.center();
   if (!s.scene.mesh.triangles.empty() || !s.scene.mesh.vertices.empty()) {
-    const MeshArrays a = prepare_mesh(s.scene.mesh, s.origin, s.options);
+    const MeshArrays a = prepare_mesh(s.scene.mesh, s.origin, s.options, s.scene.simplified.get());
     s.mesh = make_vao(gl);
     attribute(gl, s.mesh, 0, 3, a.positions);
     attribute(gl, s.mesh, 1, 3, a.normals);

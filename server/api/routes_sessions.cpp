@@ -277,7 +277,8 @@ void add_session_routes(std::vector<Route>& r) {
   // ---- region of influence (thesis table 4.1 B, D; appended: fuzz_api's seeds index routes)
   r.push_back({"PUT", "/api/v1/sessions/{id}/roi",
                "Store a region of influence: a copy of the session's committed band ({}) or of a snapshot "
-               "({\"snapshot\": SID}) that speed formulas read as roi and frames show with roi=on",
+               "({\"snapshot\": SID}) or of another session's committed band ({\"session\": ID}) that speed formulas read "
+               "as roi and frames show with roi=on",
                true, false, {}, kJson, {{"200", "the session"}, {"404", "unknown snapshot"}},
                [](RouteContext& c) { c.reply(200, c.service.put_roi(c.param(1), c.body())); }});
   r.push_back({"DELETE", "/api/v1/sessions/{id}/roi", "Remove the session's region of influence", true, false, {},
@@ -286,6 +287,9 @@ void add_session_routes(std::vector<Route>& r) {
                  c.service.sessions().remove_roi(*s);
                  c.reply(204, nullptr);
                }});
+  r.push_back({"GET", "/api/v1/sessions/{id}/roi", "The session's region of influence, as a band (.lsg)", false, false,
+               {}, nullptr, {{"200", "the band"}, {"404", "the session has none"}},
+               [](RouteContext& c) { send_blob(c, c.service.roi(c.param(1))); }});
 }
 
 }  // namespace levelset::api

@@ -18,7 +18,7 @@ class GlSceneRenderer : public SceneRenderer {
 
   void set_scene(std::shared_ptr<const NarrowBand> band, const TriangleMesh& surface,
                  std::shared_ptr<const PointCloud> points, std::shared_ptr<const NarrowBand> roi) override {
-    scene_.set_scene(render::SceneData{surface, points ? *points : PointCloud{}, std::move(band), std::move(roi)});
+    scene_.set_scene(render::SceneData{surface, points ? *points : PointCloud{}, std::move(band), std::move(roi), nullptr});
   }
 
   EncodedFrame render(const nlohmann::json& view, const std::vector<std::pair<std::string, std::string>>& query, int width,

@@ -218,8 +218,17 @@ json Service::put_roi(const std::string& id, const json& body) {
   auto s = sessions_->get(id);
   if (!body.is_object()) throw bad_request("expected {} (the current band) or {\"snapshot\": SNAPSHOT_ID}");
   for (const auto& [key, value] : body.items())
-    if (key != "snapshot") throw unprocessable("body." + key.substr(0, 40), "unknown field (snapshot)");
-  if (body.contains("snapshot")) {
+    if (key != "snapshot" && key != "session")
+      throw unprocessable("body." + key.substr(0, 40), "unknown field (snapshot, session)");
+  if (body.size() > 1) throw unprocessable("body", "give one of snapshot and session");
+  if (body.contains("session")) {
+    // Another session's committed band (thesis table 4.1 B: a distance field computed with the
+    // ROI option becomes the static array of the surface being evolved). Sampled by world
+    // position, so the two grids need not match.
+    if (!body["session"].is_string()) throw unprocessable("body.session", "expected a session id");
+    auto source = sessions_->get(body["session"].get<std::string>());
+    sessions_->store_roi(*s, *source->band(), {{"session", source->id()}, {"version", source->version()}});
+  } else if (body.contains("snapshot")) {
     if (!body["snapshot"].is_string()) throw unprocessable("body.snapshot", "expected a snapshot id");
     const std::string sid = body["snapshot"].get<std::string>();
     bool known = false;

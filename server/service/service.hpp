@@ -81,7 +81,8 @@ class Service {
   // {"name": NEW} renames; {"points": UPLOAD | null} shows a point upload with the session (or
   // stops showing its cloud). Either or both.
   nlohmann::json patch_session(const std::string& id, const nlohmann::json& body);
-  // The session's region of influence from its committed band ({}) or a snapshot ({"snapshot": SID}).
+  // The session's region of influence from its committed band ({}), a snapshot ({"snapshot": SID})
+  // or another session's committed band ({"session": ID}).
   nlohmann::json put_roi(const std::string& id, const nlohmann::json& body);
   Reply snapshot(const std::string& id, const nlohmann::json& body);
   nlohmann::json restore(const std::string& id, const std::string& snapshot_id);
@@ -99,6 +100,7 @@ class Service {
   Blob mesh(const std::string& session_id, const MeshQuery& query);
   Blob band(const std::string& session_id);
   Blob points(const std::string& session_id);  // the session's point cloud file (404: none)
+  Blob roi(const std::string& session_id);     // the session's region of influence as .lsg (404: none)
   Blob voxels(const std::string& session_id, const VoxelQuery& query, std::uint64_t& total, std::string& fields);
 
   // Idempotency-Key: the first answer to a key is replayed for 24 h (bounded memory).

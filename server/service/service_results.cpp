@@ -105,6 +105,19 @@ Blob Service::points(const std::string& session_id) {
   return b;
 }
 
+Blob Service::roi(const std::string& session_id) {
+  auto s = sessions_->get(session_id);
+  const json info = s->describe().value("roi", json());
+  auto band = s->roi();
+  if (!info.is_object() || !band) throw ApiError(404, "not_found", "session " + session_id + " has no region of influence");
+  Blob b;
+  b.bytes = std::make_shared<const std::string>(encode_lsg(*band));
+  b.etag = "\"" + session_id + "-" + info.value("file", "roi") + "\"";
+  b.content_type = "application/octet-stream";
+  b.file_name = session_id + "-roi.lsg";
+  return b;
+}
+
 Blob Service::voxels(const std::string& session_id, const VoxelQuery& q, std::uint64_t& total, std::string& fields) {
   auto s = sessions_->get(session_id);
   bool want_value = false, want_closest = false, want_curvature = false;

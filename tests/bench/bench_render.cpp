@@ -111,7 +111,7 @@ int main(int argc, char** argv) {
     {
       const auto t = Clock::now();
       SceneRenderer renderer(context->gl());
-      renderer.set_scene(SceneData{knot_tube(quick ? 500 : 1000, 50), {}, nullptr, nullptr});
+      renderer.set_scene(SceneData{knot_tube(quick ? 500 : 1000, 50), {}, nullptr, nullptr, nullptr});
       const double upload = ms_since(t);
       double first = 0;
       const Figures f = measure(renderer, view, frames, &first);
@@ -125,7 +125,7 @@ int main(int argc, char** argv) {
       SceneOptions options;  // the default budget (200k triangles); --quick: a quarter of the mesh
       if (quick) options.moving_triangle_budget = 50000;
       SceneRenderer renderer(context->gl(), options);
-      renderer.set_scene(SceneData{knot_tube(quick ? 1000 : 5000, 100), {}, nullptr, nullptr});
+      renderer.set_scene(SceneData{knot_tube(quick ? 1000 : 5000, 100), {}, nullptr, nullptr, nullptr});
       const double upload = ms_since(t);
       std::printf("  mesh %zu triangles, upload + simplification %.0f ms, simplified copy %zu triangles\n",
                   renderer.scene().mesh.triangles.size(), upload, renderer.simplified_triangles());
@@ -150,7 +150,7 @@ int main(int argc, char** argv) {
       std::printf("  knot band %d^3: %zu active voxels, built in %.0f ms\n", resolution, band->active_voxel_count(),
                   ms_since(t));
       SceneRenderer renderer(context->gl());
-      renderer.set_scene(SceneData{marching_cubes(*band).mesh, {}, band, nullptr});
+      renderer.set_scene(SceneData{marching_cubes(*band).mesh, {}, band, nullptr, nullptr});
       ViewSettings v = view;
       v.shading = Shading::None;
       v.volume = true;

@@ -16,6 +16,12 @@ ImGui mouse / keyboard input; the window's state comes back as JSON dumps):
              kept), restore the snapshot, redistance (H), load a point cloud (J) and reconstruct
              a session from it, run a job file (its session is shown),
              delete: each checked on the daemon.
+  roi        thesis B's ROI option and D's Point(ROI): a sphere session, then CGAL's knot loaded (C)
+             and its distance field computed with ROI checked becomes the sphere's region of
+             influence (the knot's session is removed, the sphere shown again); D's ROI draws
+             its points (local and remote frames); a formula reading roi evolves the sphere;
+             Store / Clear ROI; a session reconstructed from points (made over the API) shows
+             its cloud when selected (I), fetched from the daemon.
   reconnect  a killed daemon shows the banner; the daemon restarted on the same port clears it.
   auth       a daemon with tokens: a wrong token shows the "refuses" banner, a read-only token
              gets the server's "forbidden" error when it creates a session, a read-write token
@@ -38,7 +44,7 @@ import time
 from PIL import Image  # python3-pil; missing: the test fails here
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "integration"))
-from daemon_harness import Daemon  # noqa: E402
+from daemon_harness import Daemon, upload  # noqa: E402
 
 GUI, LEVELSETD, SCRATCH, CGAL, SCENARIO = sys.argv[1:6]
 KNOT = os.path.join(CGAL, "meshes", "knot.off")
@@ -292,6 +298,82 @@ def sessions_with(daemon):
     check(status == 404 and deleted["session"] == "", f"delete: {status}, shown {deleted['session']!r}")
 
 
+def scenario_roi():
+    daemon = Daemon(LEVELSETD, os.path.join(SCRATCH, "data"))
+    try:
+        roi_with(daemon)
+    finally:
+        daemon.stop()
+
+
+def roi_with(daemon):
+    d = os.path.join(SCRATCH, "roi")
+    # A session reconstructed from points over the API: the window shows its cloud when selected.
+    status, _, up = upload(daemon, POINTS, "xyz")
+    check(status == 201, f"upload the points: {status} {up}")
+    status, _, job = daemon.post("/api/v1/sessions", {"upload": up["id"], "raster": {"resolution": 48}})
+    job = daemon.wait_job(job["id"])
+    check(job["state"] == "succeeded", f"reconstruct over the API: {job}")
+    cloud_session = job["result"]["session"]
+    script = [
+        "wait_connected 30", "set primitive sphere", "set resolution 48", "press create_primitive", "wait_session 60",
+        "wait_surface 60", f"dump {d}/sphere.json",
+        # C then B with ROI: the knot's field becomes the sphere's region of influence.
+        f"set mesh_file {KNOT}", "press load_mesh", "wait_idle 60", "frames 3", f"dump {d}/file.json",
+        "set resolution 64", "set band 4", "click ROI", "click 'Compute distance field'", "wait_idle 120",
+        "wait_session 60", "wait_surface 60", "frames 3", f"dump {d}/stored.json",
+        # D: Point(ROI) with the surface hidden, then nothing with D at none.
+        "click none", "click ROI##field", "wait_idle 60", "frames 20", f"screenshot {d}/roi.png", f"dump {d}/roi.json",
+        "click none##field", "frames 5", f"screenshot {d}/none.png",
+        # G with roi in the formula: the sphere is drawn toward the knot's surface.
+        "set formula -roi", "set steps 10", "press evolve", "wait_idle 120", "expect_no_errors", f"dump {d}/evolved.json",
+        # Remote frames follow D's ROI (PUT view roi).
+        "click ROI##field", "set triangle_budget 1", "wait_surface 60", "frames 30", f"screenshot {d}/remote.png",
+        f"dump {d}/remote.json", "set triangle_budget 2000000", "click none##field",
+        # Clear ROI, then Store field as ROI (the session's own field).
+        "click 'Clear ROI'", "wait_idle 30", "frames 3", f"dump {d}/cleared.json",
+        "click 'Store field as ROI'", "wait_idle 30", "frames 3", f"dump {d}/own.json",
+        # I: the reconstructed session's cloud, fetched from the daemon.
+        f"select {cloud_session}", "set cloud 1", "wait_surface 60", "wait_idle 60", "frames 10",
+        f"screenshot {d}/cloud.png", f"dump {d}/cloud.json"]
+    proc, d = start_gui("roi", script, "--server", daemon.url)
+    finish_gui(proc, d, timeout=280)
+    sphere = load_json(os.path.join(d, "sphere.json"))["session"]
+    check(load_json(os.path.join(d, "file.json"))["session"] == "", "C's mesh file is shown in place of the sphere")
+    stored = load_json(os.path.join(d, "stored.json"))
+    check(stored["session"] == sphere and not stored["errors"], f"the sphere is not shown again: {stored['session']} "
+          f"{stored['errors']}")
+    roi = stored["roi"]  # the sphere's description as the window had it
+    check(isinstance(roi, dict) and roi.get("session") and roi["active_voxels"] > 5000, f"the sphere's roi: {roi}")
+    status, _, _ = daemon.get(f"/api/v1/sessions/{roi['session']}")
+    check(status == 404, f"the knot's session made for the ROI is not removed: {status}")
+    _, _, sessions = daemon.get("/api/v1/sessions")
+    check(sorted(x["id"] for x in sessions["sessions"]) == sorted([sphere, cloud_session]), f"sessions: {sessions}")
+    shown = load_json(os.path.join(d, "roi.json"))
+    check(shown["view"]["roi_loaded"] and shown["panel"]["field"] == 5, f"D's ROI: {shown['view']}")
+    lit = scene_fraction(os.path.join(d, "roi.png"), lambda p: sum(p) > 200)
+    empty = scene_fraction(os.path.join(d, "none.png"), lambda p: sum(p) > 200)
+    print(f"ROI points cover {lit:.3f} of the scene, none {empty:.3f}")
+    check(lit > 0.02 and empty < 0.002, f"ROI points: {lit:.3f} of the scene, with D at none {empty:.3f}")
+    evolved = load_json(os.path.join(d, "evolved.json"))
+    check(evolved["version"] > stored["version"], f"evolve with roi: v{stored['version']} -> v{evolved['version']}")
+    _, _, history = daemon.get(f"/api/v1/sessions/{sphere}/history")
+    check("-roi" in json.dumps(history), "the roi formula is not in the history")
+    remote = load_json(os.path.join(d, "remote.json"))
+    check(remote["view"]["remote"] and remote["view"]["frames_received"] > 0, f"remote frames: {remote['view']}")
+    # Shading none and no cloud: what the daemon's frame shows is the ROI's points (roi=on in its view).
+    lit_remote = scene_fraction(os.path.join(d, "remote.png"), lambda p: sum(p) > 200)
+    check(lit_remote > 0.02, f"no ROI points in the remote frame ({lit_remote:.3f})")
+    cleared = load_json(os.path.join(d, "cleared.json"))
+    check(cleared["errors"] == [] and cleared["roi"] is None, f"Clear ROI: {cleared['roi']} {cleared['errors']}")
+    own, final = load_json(os.path.join(d, "own.json")), daemon.get(f"/api/v1/sessions/{sphere}")[2]["roi"]
+    check(isinstance(own["roi"], dict) and own["roi"].get("version") == own["version"] and final == own["roi"],
+          f"Store field as ROI: {own['roi']}, the daemon's {final}")
+    cloud = load_json(os.path.join(d, "cloud.json"))
+    check(cloud["session"] == cloud_session and cloud["view"]["cloud_points"] == up["summary"]["points"],
+          f"I: {cloud['view']}, uploaded {up['summary']}")
+
+
 def free_port():
     with socket.socket() as s:
         s.bind(("127.0.0.1", 0))
@@ -437,7 +519,7 @@ def main():
     shutil.rmtree(SCRATCH, ignore_errors=True)
     os.makedirs(SCRATCH)
     t0 = time.monotonic()
-    {"workflow": scenario_workflow, "sessions": scenario_sessions, "reconnect": scenario_reconnect,
+    {"workflow": scenario_workflow, "sessions": scenario_sessions, "reconnect": scenario_reconnect, "roi": scenario_roi,
      "auth": scenario_auth, "embedded": scenario_embedded}[SCENARIO]()
     print(f"gui {SCENARIO}: ok in {time.monotonic() - t0:.1f} s")
 

@@ -747,6 +747,31 @@ def test_fields():
         check(status == 422, f"an unknown field: {status} {body}")
         check(d.request("DELETE", f"/api/v1/sessions/{sid}/roi")[0] == 204, "DELETE roi")
         check(d.get(f"/api/v1/sessions/{sid}")[2]["roi"] is None, "the ROI is gone")
+        check(d.get(f"/api/v1/sessions/{sid}/roi")[0] == 404, "GET roi without one: 404")
+        # Another session's band as the ROI (thesis B's ROI option: a distance field computed for
+        # the surface being evolved), on another grid: a unit sphere at resolution 32 whose band
+        # (8 voxels) reaches the front at radius ~1.28. With speed -roi the radius follows
+        # r' = 1 - r, so r(3) = 1 + (r0 - 1) e^-3.
+        status, _, unit = d.post("/api/v1/sessions", {"primitive": "sphere", "raster": {"resolution": 32, "band": 8}})
+        check(status == 201, f"the ROI's session: {status} {unit}")
+        status, _, body = d.json_request("PUT", f"/api/v1/sessions/{sid}/roi", {"session": unit["id"]})
+        check(status == 200 and body["roi"]["session"] == unit["id"], f"PUT roi from a session: {status} {body}")
+        status, _, data = d.request("GET", f"/api/v1/sessions/{sid}/roi")
+        check(status == 200 and data == d.request("GET", f"/api/v1/sessions/{unit['id']}/band")[2],
+              "GET roi gives the other session's band")
+        def measured_radius():
+            status, _, job = d.post(f"/api/v1/sessions/{sid}/jobs", {"op": "measure"})
+            return (3 * d.wait_job(job["id"])["result"]["volume"] / (4 * math.pi)) ** (1 / 3)
+        r0 = measured_radius()
+        status, _, job = d.post(f"/api/v1/sessions/{sid}/jobs", {"op": "evolve", "speed": "-roi", "time": 3})
+        check(d.wait_job(job["id"])["state"] == "succeeded", "evolve with -roi")
+        after, expected = measured_radius(), 1 + (r0 - 1) * math.exp(-3)
+        check(r0 > 1.2, f"the front starts outside the unit sphere: {r0:.4f}")
+        check(abs(after - expected) < 0.02, f"the front follows r' = 1 - r: radius {after:.4f}, expected {expected:.4f}")
+        for bad, code in (({"session": "vm-s-0000000000000000"}, 404), ({"session": 7}, 422),
+                          ({"session": unit["id"], "snapshot": "x"}, 422)):
+            status, _, body = d.json_request("PUT", f"/api/v1/sessions/{sid}/roi", bad)
+            check(status == code, f"PUT roi {bad}: {status} {body}")
     finally:
         d.stop()
 

@@ -20,7 +20,7 @@ class Overlays : public test::RenderFixture {};
 
 const SceneData& sphere() { return test::sphere_scene(); }
 
-SceneData band_only(const SceneData& s) { return SceneData{{}, {}, s.band, nullptr}; }
+SceneData band_only(const SceneData& s) { return SceneData{{}, {}, s.band, nullptr, nullptr}; }
 
 ViewSettings front_view(int w, int h) {  // looking down -z at the scene's centre
   ViewSettings v;

@@ -136,6 +136,27 @@ TEST_P(SceneRender, MovingViewDrawsTheSimplifiedCopy) {
   EXPECT_NEAR(double(moving_area), double(area), 0.03 * area);
 }
 
+// The simplified copy made beforehand (off a window's UI thread) is the one set_scene would make,
+// and set_scene uses it rather than simplifying again.
+TEST_P(SceneRender, SimplifiedCopyMadeBeforehand) {
+  SceneOptions options;
+  options.moving_triangle_budget = 2000;
+  SceneData scene = sphere();
+  const std::vector<std::uint32_t> made = motion_indices(scene.mesh, options);
+  ASSERT_GT(made.size(), 300u);
+  ASSERT_LE(made.size(), 3 * 2000u);
+  EXPECT_EQ(made, prepare_mesh(scene.mesh, scene_bounds(scene).center(), options).simplified);
+  EXPECT_TRUE(motion_indices(scene.mesh, SceneOptions{}).empty());  // within the default budget
+  std::vector<std::uint32_t> few(made.begin(), made.begin() + 30);  // 10 triangles, recognisably not its own
+  scene.simplified = std::make_shared<const std::vector<std::uint32_t>>(few);
+  renderer = std::make_unique<SceneRenderer>(context->gl(), options);
+  renderer->set_scene(scene);
+  EXPECT_EQ(renderer->simplified_triangles(), 10u);
+  few[0] = std::uint32_t(scene.mesh.vertices.size());  // out of range: refused, named
+  scene.simplified = std::make_shared<const std::vector<std::uint32_t>>(few);
+  EXPECT_THROW(renderer->set_scene(scene), Error);
+}
+
 TEST_P(SceneRender, PointCloud) {
   SceneData scene;
   for (int i = 0; i < 2000; ++i) {  // a Fibonacci sphere of radius 1
