@@ -1,5 +1,6 @@
 // sessions list | create (--primitive NAME | --upload ID [--param k=v ...]) [--resolution N] [--name N] [--wait]
 //          | show ID | delete ID | snapshot ID [--name N]
+//          | roi ID [--from-session S | --snapshot N | --clear]  (the region of influence formulas read as roi)
 #include <cstdio>
 #include <memory>
 
@@ -13,10 +14,10 @@ using nlohmann::json;
 namespace {
 
 struct SessionArgs {
-  std::string id, primitive, upload, name;
+  std::string id, primitive, upload, name, from_session, snapshot;
   std::vector<std::string> params;
   int resolution = 0;
-  bool json = false, wait = false;
+  bool json = false, wait = false, clear = false;
 };
 
 std::string text_of(const json& j, const char* key) {
@@ -98,6 +99,26 @@ void add_session_commands(CLI::App& app, Globals& g) {
     json body = json::object();
     if (!a->name.empty()) body["name"] = a->name;
     print_json(g.api().post(session_path(a->id) + "/snapshots", body));
+  });
+
+  CLI::App* roi = s->add_subcommand("roi", "Store the session's region of influence (formulas read it as roi): its "
+                                           "committed band, a snapshot's or another session's; prints the session");
+  roi->add_option("id", a->id, "Session id")->required();
+  auto* from = roi->add_option("--from-session", a->from_session, "Another session whose committed band it becomes");
+  auto* snapshot = roi->add_option("--snapshot", a->snapshot, "A snapshot of this session whose band it becomes");
+  auto* clear = roi->add_flag("--clear", a->clear, "Remove the region of influence");
+  from->excludes(snapshot)->excludes(clear);
+  snapshot->excludes(clear);
+  roi->callback([a, &g] {
+    const Api api = g.api();
+    if (a->clear) {
+      api.del(session_path(a->id) + "/roi");
+      return print_json(api.get(session_path(a->id)));
+    }
+    json body = json::object();
+    if (!a->from_session.empty()) body["session"] = a->from_session;
+    if (!a->snapshot.empty()) body["snapshot"] = a->snapshot;
+    print_json(api.put(session_path(a->id) + "/roi", body));
   });
 }
 

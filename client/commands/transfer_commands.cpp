@@ -1,5 +1,5 @@
 // upload FILE [--format F]; download mesh SESSION -o FILE [--iso V] [--method mc|nets];
-// download band SESSION -o FILE.lsg.
+// download band SESSION -o FILE.lsg; download roi SESSION -o FILE.lsg; download points SESSION -o FILE.
 #include <cstdio>
 #include <filesystem>
 #include <memory>
@@ -51,7 +51,7 @@ void add_upload_command(CLI::App& app, Globals& g) {
 }
 
 void add_download_commands(CLI::App& app, Globals& g) {
-  CLI::App* dl = app.add_subcommand("download", "Download a session's surface or band");
+  CLI::App* dl = app.add_subcommand("download", "Download a session's surface, band, region of influence or points");
   dl->require_subcommand(1);
   auto m = std::make_shared<DownloadArgs>();
   CLI::App* mesh = dl->add_subcommand("mesh", "The surface as a mesh; the format from -o's extension (ply obj off stl)");
@@ -80,6 +80,20 @@ void add_download_commands(CLI::App& app, Globals& g) {
       throw ClientError(ClientError::Kind::Usage, "unknown_format", "a band is written as .lsg, not '" + b->output + "'");
     g.api().download("/api/v1/sessions/" + Api::encode(b->session) + "/band", b->output);
   });
+  auto r = std::make_shared<DownloadArgs>();
+  CLI::App* roi = dl->add_subcommand("roi", "The region of influence as an .lsg file");
+  roi->add_option("session", r->session, "Session id")->required();
+  roi->add_option("-o,--output", r->output, "Output file (.lsg)")->required();
+  roi->callback([r, &g] {
+    if (lower_extension(r->output) != "lsg")
+      throw ClientError(ClientError::Kind::Usage, "unknown_format", "a band is written as .lsg, not '" + r->output + "'");
+    g.api().download("/api/v1/sessions/" + Api::encode(r->session) + "/roi", r->output);
+  });
+  auto p = std::make_shared<DownloadArgs>();
+  CLI::App* points = dl->add_subcommand("points", "The session's point cloud, as uploaded (sessions show: points.format)");
+  points->add_option("session", p->session, "Session id")->required();
+  points->add_option("-o,--output", p->output, "Output file")->required();
+  points->callback([p, &g] { g.api().download("/api/v1/sessions/" + Api::encode(p->session) + "/points", p->output); });
 }
 
 }  // namespace levelset::client

@@ -322,6 +322,19 @@ def scenario_commands(ctx, cgal, readme, jobs_dir):
     check(not os.path.exists(os.path.join(ctx.scratch, "nothing.lsg")), "a refused download left a file")
     snap = json.loads(ctx.ok(["sessions", "snapshot", sid, "--name", "first"]).stdout)
     check(snap.get("name") == "first", f"snapshot {snap}")
+    # The region of influence: another session's band, downloaded as the API gives it; cleared.
+    other = ctx.ok(["sessions", "create", "--primitive", "torus", "--resolution", "32"]).stdout.strip()
+    shown = json.loads(ctx.ok(["sessions", "roi", sid, "--from-session", other]).stdout)
+    check(shown["roi"]["session"] == other, f"sessions roi --from-session: {shown['roi']}")
+    ctx.ok(["download", "roi", sid, "-o", "roi.lsg"])
+    status, body = ctx.http("GET", f"/api/v1/sessions/{other}/band", raw=True)
+    check(open(os.path.join(ctx.scratch, "roi.lsg"), "rb").read() == body, "download roi is not the torus's band")
+    check(json.loads(ctx.ok(["sessions", "roi", sid, "--snapshot", snap["id"]]).stdout)["roi"]["snapshot"] == snap["id"],
+          "sessions roi --snapshot")
+    check(json.loads(ctx.ok(["sessions", "roi", sid, "--clear"]).stdout)["roi"] is None, "sessions roi --clear")
+    ctx.refused(["download", "roi", sid, "-o", "none.lsg"], 1, "not_found")
+    ctx.refused(["sessions", "roi", sid, "--clear", "--snapshot", snap["id"]], 2, "usage")
+    ctx.refused(["download", "points", sid, "-o", "none.xyz"], 1, "not_found")
 
     # An unknown session, a failing job, a refused parameter.
     msg = ctx.refused(["jobs", "submit", "vm-s-0123456789abcdef", "--op", "offset", "--param", "distance=0.1"], 1,
