@@ -6,6 +6,7 @@
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
+#include <tbb/parallel_invoke.h>
 
 #include "distance/eikonal_update.hpp"
 
@@ -26,7 +27,17 @@ inline bool step(const RedistanceDomain& w, std::uint32_t& b, int& n, int dir) {
   return true;
 }
 
-// Upwind update from the accepted neighbours (w.dist holds +inf for all others).
+// During the march w.dist holds, per voxel: its distance once fixed or accepted (>= 0), minus its
+// tentative value while it is in the trial set (< 0), +inf otherwise: one array, so that a pop
+// touches one cache line per voxel rather than two (the march's cost is its cache misses: it
+// visits the front in value order, all over the surface).
+// (signbit: a tentative value of 0 is stored as -0.)
+inline bool tentative(float v) { return std::signbit(v); }
+inline bool known(float v) { return !std::signbit(v) && v < kInf; }
+
+// Upwind update from the accepted neighbours on the voxel's
+// own side of the interface or fixed. (Only a band whose sign changes outside its active voxels
+// has a free neighbour of the other side; skipping it keeps the two sides' marches apart.)
 inline float known_update(const RedistanceDomain& w, std::uint32_t b, int n, bool second_order) {
   const bool inside = w.inside[b].test(n);
   AxisTerm terms[3];
@@ -36,13 +47,14 @@ inline float known_update(const RedistanceDomain& w, std::uint32_t b, int n, boo
       std::uint32_t b1 = b;
       int n1 = n;
       if (!step(w, b1, n1, 2 * a + s)) continue;
+      if (w.inside[b1].test(n1) != inside && !w.fixed[b1].test(n1)) continue;
       const float v1 = w.values(b1)[n1];
-      if (!(v1 < m1)) continue;
+      if (!known(v1) || !(v1 < m1)) continue;
       m1 = v1;
       m2 = kInf;
-      if (second_order && step(w, b1, n1, 2 * a + s)) {
+      if (second_order && step(w, b1, n1, 2 * a + s) && (w.inside[b1].test(n1) == inside || w.fixed[b1].test(n1))) {
         const float v2 = w.values(b1)[n1];
-        if (v2 < kInf) m2 = w.inside[b1].test(n1) == inside ? v2 : -v2;
+        if (known(v2)) m2 = w.inside[b1].test(n1) == inside ? v2 : -v2;
       }
     }
     terms[a] = axis_term(m1, m2, second_order && std::abs(m2) < kInf);
@@ -85,19 +97,27 @@ class TrialQueue {
     for (auto& h : slices_) std::make_heap(h.begin(), h.end(), HeapAfter{});
   }
   bool pop(HeapEntry& e) {
-    while (current_ < slices_.size() && slices_[current_].empty()) {
-      slices_[current_].shrink_to_fit();
-      ++current_;
-    }
-    if (current_ == slices_.size()) return false;
+    if (!advance()) return false;
     std::vector<HeapEntry>& h = slices_[current_];
     std::pop_heap(h.begin(), h.end(), HeapAfter{});
     e = h.back();
     h.pop_back();
     return true;
   }
+  // The entry pop() would give next (nullptr: none), for prefetching its voxel.
+  const HeapEntry* peek() {
+    if (!advance()) return nullptr;
+    return &slices_[current_].front();
+  }
 
  private:
+  bool advance() {
+    while (current_ < slices_.size() && slices_[current_].empty()) {
+      slices_[current_].shrink_to_fit();
+      ++current_;
+    }
+    return current_ < slices_.size();
+  }
   static constexpr double kSlicesPerVoxel = 256.0;
   static constexpr std::size_t kMaxSlices = 1 << 16;
   std::size_t slice_of(float v) const {
@@ -112,12 +132,41 @@ class TrialQueue {
   std::size_t current_ = 0;
 };
 
+// Accepts the voxels of one side (inside or not) smallest tentative value first.
+void march_side(RedistanceDomain& w, TrialQueue& trial, bool inside, bool second, const ProgressHook& progress) {
+  std::uint64_t pops = 0;
+  HeapEntry e;
+  while (trial.pop(e)) {
+    if ((++pops & 0xffff) == 0) progress.check("redistance march");
+    if (!tentative(w.dist[e.id])) continue;  // accepted earlier with a smaller value
+    w.dist[e.id] = e.value;
+    if (const HeapEntry* next = trial.peek()) {  // its voxel's line and masks arrive meanwhile
+      __builtin_prefetch(&w.dist[next->id]);
+      __builtin_prefetch(&w.inside[next->id / kBrickVoxels]);
+    }
+    const std::uint32_t b = e.id / kBrickVoxels;
+    const int v = int(e.id % kBrickVoxels);
+    for (int dir = 0; dir < 6; ++dir) {
+      std::uint32_t b2 = b;
+      int n2 = v;
+      if (!step(w, b2, n2, dir) || !w.domain[b2].test(n2) || w.inside[b2].test(n2) != inside) continue;
+      const std::uint32_t id2 = b2 * std::uint32_t(kBrickVoxels) + std::uint32_t(n2);
+      const float d = w.dist[id2];
+      if (known(d)) continue;  // fixed or accepted
+      const float t = known_update(w, b2, n2, second);
+      if (d == kInf || t < -d) {
+        w.dist[id2] = -t;
+        trial.push({t, id2});
+      }
+    }
+  }
+}
+
 }  // namespace
 
 void march(RedistanceDomain& w, int order, double limit, const ProgressHook& progress) {
   const std::size_t n = w.size();
   const bool second = order == 2;
-  std::vector<float> tentative(w.dist.size(), kInf);
   // Initial front: free voxels next to an interface voxel, per brick in parallel.
   std::vector<std::vector<HeapEntry>> front(n);
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 16), [&](const tbb::blocked_range<std::size_t>& r) {
@@ -133,40 +182,34 @@ void march(RedistanceDomain& w, int order, double limit, const ProgressHook& pro
           near = step(w, b2, n2, dir) && w.values(b2)[n2] < kInf;
         }
         if (!near) return;
-        const float t = known_update(w, b, v, second);
-        tentative[std::size_t(b) * kBrickVoxels + v] = t;
-        front[b].push_back({t, b * std::uint32_t(kBrickVoxels) + std::uint32_t(v)});
+        front[b].push_back({known_update(w, b, v, second), b * std::uint32_t(kBrickVoxels) + std::uint32_t(v)});
       });
     }
   });
-  TrialQueue trial(limit);
+  // The two sides of the interface march apart (each reads only its own side and the fixed
+  // interface voxels: a free voxel next to the other side would be an interface voxel), so
+  // they run in parallel and give what one march over both gives.
+  TrialQueue trial[2] = {TrialQueue(limit), TrialQueue(limit)};
   {
-    std::vector<HeapEntry> all;
-    for (auto& f : front) all.insert(all.end(), f.begin(), f.end());
-    front = {};
-    trial.assign(all);
-  }
-  std::uint64_t pops = 0;
-  HeapEntry e;
-  while (trial.pop(e)) {
-    if ((++pops & 0xffff) == 0) progress.check("redistance march");
-    if (w.dist[e.id] < kInf) continue;  // accepted earlier with a smaller value
-    w.dist[e.id] = e.value;
-    const std::uint32_t b = e.id / kBrickVoxels;
-    const int v = int(e.id % kBrickVoxels);
-    for (int dir = 0; dir < 6; ++dir) {
-      std::uint32_t b2 = b;
-      int n2 = v;
-      if (!step(w, b2, n2, dir) || !w.domain[b2].test(n2)) continue;
-      const std::uint32_t id2 = b2 * std::uint32_t(kBrickVoxels) + std::uint32_t(n2);
-      if (w.dist[id2] < kInf) continue;
-      const float t = known_update(w, b2, n2, second);
-      if (t < tentative[id2]) {
-        tentative[id2] = t;
-        trial.push({t, id2});
+    std::vector<HeapEntry> sides[2];
+    for (const auto& f : front)
+      for (const HeapEntry& e : f) {
+        // Marked tentative only now: the front's updates above read the fixed voxels alone.
+        if (e.value < kInf) w.dist[e.id] = -e.value;
+        sides[w.inside[e.id / kBrickVoxels].test(int(e.id % kBrickVoxels)) ? 1 : 0].push_back(e);
       }
-    }
+    front = {};
+    trial[0].assign(sides[0]);
+    trial[1].assign(sides[1]);
   }
+  tbb::parallel_invoke([&] { march_side(w, trial[0], false, second, progress); },
+                       [&] { march_side(w, trial[1], true, second, progress); });
+  // Voxels left in the trial set (beyond the limit) are unknown.
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, w.dist.size(), 1 << 16),
+                    [&](const tbb::blocked_range<std::size_t>& r) {
+                      for (std::size_t i = r.begin(); i != r.end(); ++i)
+                        if (tentative(w.dist[i])) w.dist[i] = kInf;
+                    });
 }
 
 }  // namespace levelset::detail

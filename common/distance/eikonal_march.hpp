@@ -10,8 +10,10 @@
 //   smallest tentative value exceeds the limit. The trial set is a TrialQueue: binary
 //   min-heaps with lazy deletion, one per 1/256-voxel slice of [0, limit] (the pop order of
 //   one global heap, with small heaps).
-// Cost: O(N log N) for N voxels reached; 4 more bytes per domain voxel (tentative values).
-// Threading: the initial front is found per brick in parallel (TBB); the march is serial.
+// Cost: O(N log N) for N voxels reached (tentative values live in w.dist, negated).
+// Threading: the initial front is found per brick in parallel (TBB); the inside and the outside
+//   march in parallel (two tasks), each reading only its own side and the fixed voxels, so
+//   the result does not depend on the thread count.
 //   Errors: Error{Cancelled} from progress, checked every 65536 heap pops.
 #pragma once
 
