@@ -163,7 +163,7 @@ void row(const char* what, int res, int threads, std::uint64_t voxels, double se
               seconds, double(voxels) / seconds / 1e6, ratio, quality, note.c_str());
 }
 
-bool run_case(int res, int runs) {
+bool run_case(int res, int runs, bench::RatioSummary& summary) {
   const auto knot = make_builtin_shape("knot");
   SdfBuildOptions build;
   build.frame = frame_for_resolution(knot->bounds(), res, 3.0);
@@ -231,6 +231,8 @@ bool run_case(int res, int runs) {
         }
         const std::string what = std::string(method == RedistanceMethod::Sweep ? "ours sweep" : "ours march") +
                                  (order == 2 ? "" : " (order 1)");
+        summary.add(what + " / sdfToSdf", 0.5, "R=" + std::to_string(res) + " thr=" + std::to_string(threads),
+                    t / vdb_sweep_seconds[threads]);
         row(what.c_str(), res, threads, voxels, t, vdb_sweep_seconds[threads], q,
             method == RedistanceMethod::Sweep ? std::to_string(r.sweep_iterations) + " iterations" : "");
       }
@@ -251,7 +253,9 @@ int main(int argc, char** argv) {
               "vs VDB sw", "|grad|-1", "x-shift", "signs");
   return bench::run_bench("bench_redistance", "a result failed its sanity bound", [&] {
     bool ok = true;
-    for (int r : res) ok &= run_case(r, quick ? 1 : 3);
+    bench::RatioSummary summary("bench_redistance");
+    for (int r : res) ok &= run_case(r, quick ? 1 : 3, summary);
+    summary.print();
     return ok;
   });
 }

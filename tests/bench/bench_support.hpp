@@ -6,6 +6,10 @@
 //                          it returns false (then "name: failure" on stderr, unless failure is
 //                          null) or throws levelset::Error ("name: what" on stderr).
 // best_of(runs, f)         the smallest wall-clock time (seconds) of `runs` >= 1 calls of f.
+// RatioSummary             collects a bench's time ratios (ours / OpenVDB's, or ours / another
+//                          reference, lower is better) per kind of row; print() ends the bench
+//                          with one "summary" line per kind: the worst ratio, its row, the
+//                          target and whether every row met it.
 // vdb_mesh(mesh)           a TriangleMesh as OpenVDB's points and triangles (meshToLevelSet).
 // vdb_from_band(band)      an openvdb::FloatGrid level set holding the band's active voxels
 //                          and values (same index space: OpenVDB's origin 0 = ours, so
@@ -20,6 +24,8 @@
 #include <chrono>
 #include <cstdio>
 #include <cstring>
+#include <map>
+#include <string>
 #include <vector>
 
 #include <openvdb/openvdb.h>
@@ -58,6 +64,31 @@ double best_of(int runs, F&& f) {
   }
   return best;
 }
+
+class RatioSummary {
+ public:
+  explicit RatioSummary(const char* bench) : bench_(bench) {}
+  void add(const std::string& kind, double target, const std::string& row, double ratio) {
+    Kind& k = kinds_[kind];
+    k.target = target;
+    ++k.rows;
+    if (!(ratio <= k.worst)) k.worst = ratio, k.row = row;  // NaN counts as worst
+  }
+  void print() const {
+    for (const auto& [name, k] : kinds_)
+      std::printf("summary %s %s: worst ratio %.3fx (%s) over %d rows, target <= %.2fx: %s\n", bench_, name.c_str(),
+                  k.worst, k.row.c_str(), k.rows, k.target, k.worst <= k.target ? "met" : "NOT met");
+  }
+
+ private:
+  struct Kind {
+    double target = 0, worst = -1;
+    int rows = 0;
+    std::string row;
+  };
+  const char* bench_;
+  std::map<std::string, Kind> kinds_;
+};
 
 struct VdbMesh {
   std::vector<openvdb::Vec3s> points;

@@ -55,7 +55,7 @@ double cold_extract(const NarrowBand& band, int threads) {
   return seconds;
 }
 
-bool bench_mesh(const std::string& path, const std::vector<int>& resolutions, int runs) {
+bool bench_mesh(const std::string& path, const std::vector<int>& resolutions, int runs, bench::RatioSummary& summary) {
   const TriangleMesh input = read_mesh(path).mesh;
   bool ok = true;
   for (int res : resolutions) {
@@ -81,6 +81,10 @@ bool bench_mesh(const std::string& path, const std::vector<int>& resolutions, in
       std::printf("%-12s %4d %3d %8.3f %8.3f %8.3f %7.3fx %7.3fx %9zu %9zu %9zu %8.3f %7.2fx\n", name.c_str(), res,
                   threads, mc, sn, vdb, mc / vdb, sn / vdb, mc_tris, sn_tris, vdb_tris, cold, cold / mc);
       std::fflush(stdout);
+      const std::string row = name + " R=" + std::to_string(res) + " thr=" + std::to_string(threads);
+      summary.add("marching cubes / volumeToMesh", 0.5, row, mc / vdb);
+      summary.add("surface nets / volumeToMesh", 0.5, row, sn / vdb);
+      summary.add("cold / warm marching cubes", 1.5, row, cold / mc);
       ok &= mc_tris > 0 && sn_tris > 0 && vdb_tris > 0 && cold > 0;
     }
   }
@@ -96,6 +100,7 @@ int main(int argc, char** argv) {
               openvdb::getLibraryAbiVersionString(), quick ? 1 : 3);
   std::printf("%-12s %4s %3s %8s %8s %8s %8s %8s %9s %9s %9s %8s %8s\n", "mesh", "R", "thr", "mc_s", "nets_s",
               "vdb_s", "mc/vdb", "nets/vdb", "mc_tris", "nets_tris", "vdb_tris", "cold_s", "cold/mc");
+  bench::RatioSummary summary("bench_surface");
   return bench::run_bench("bench_surface", "an extractor produced no triangles", [&] {
     bool ok = true;
     for (const char* name : {"knot.off", "bunny00.off", "armadillo.off"}) {
@@ -107,9 +112,10 @@ int main(int argc, char** argv) {
       }
       const bool armadillo = std::string(name) == "armadillo.off";
       ok &= bench_mesh(path, quick ? std::vector<int>{64} : (armadillo ? std::vector<int>{256} : std::vector<int>{256, 512}),
-                       quick ? 1 : 3);
+                       quick ? 1 : 3, summary);
       if (quick) break;
     }
+    summary.print();
     return ok;
   });
 }
