@@ -13,7 +13,8 @@
 //   --meshes a.off,b.off (only these)  --max-meshes N  --ours (no Poisson)  --list (the meshes
 //   and their measurements only)  --jsonl FILE (one record per case, appended)
 //   --cache DIR (Poisson's results by case, default reconstruct-sweep-cache; reused).
-//   Development: --levels L, --shell-offset S, --curvature-weight W (reconstruction options).
+//   Development: --levels L, --shell-offset S, --curvature-weight W (reconstruction options);
+//   --keep DIR writes each case's points (KEY-points.xyz) and our surface (KEY-ours.ply).
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -35,6 +36,7 @@
 #include "core/error.hpp"
 #include "geometry/point_triangle.hpp"
 #include "io/mesh_reader.hpp"
+#include "io/mesh_writer.hpp"
 #include "reconstruct_scoring.hpp"
 #include "surface/mesh_measures.hpp"
 
@@ -56,6 +58,7 @@ struct SweepOptions {
   // Development switches (not the defaults' measurement): reconstruction options.
   int levels = 0;
   double shell_offset = 0, curvature_weight = -1;
+  std::string keep;
 };
 
 template <class T>
@@ -89,6 +92,7 @@ SweepOptions parse(int argc, char** argv) {
     else if (value && arg == "--levels") o.levels = std::atoi(argv[++a]);
     else if (value && arg == "--shell-offset") o.shell_offset = std::atof(argv[++a]);
     else if (value && arg == "--curvature-weight") o.curvature_weight = std::atof(argv[++a]);
+    else if (value && arg == "--keep") o.keep = argv[++a];
     else if (arg == "--ours") o.ours_only = true;
     else if (arg == "--list") o.list_only = true;
   }
@@ -259,6 +263,14 @@ CaseResult run_case(const SweepMesh& m, const std::vector<Vec3d>& truth_samples,
     const apps::ReconstructionResult r = apps::reconstruct_surface(points, ro);
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     c.ours = score(m.mesh, truth_samples, r.mesh, seconds);
+    if (!o.keep.empty()) {
+      char key[256];
+      std::snprintf(key, sizeof key, "%s-%zu-%g-%u", m.name.c_str(), count, noise, seed);
+      fs::create_directories(o.keep);
+      write_mesh(r.mesh, fs::path(o.keep) / (std::string(key) + "-ours.ply"));
+      std::ofstream xyz(fs::path(o.keep) / (std::string(key) + "-points.xyz"));
+      for (const Vec3d& p : points) xyz << p.x << ' ' << p.y << ' ' << p.z << '\n';
+    }
   } catch (const Error& e) {
     std::printf("  %s: ours failed: %s\n", m.name.c_str(), e.what());
   }
