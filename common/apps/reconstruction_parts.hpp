@@ -1,0 +1,76 @@
+// The parts of reconstruct_surface (apps/reconstruction.hpp), one file each:
+//   reconstruction_grid.cpp   the grids: the start shell, reframing, upsampling a level;
+//   reconstruction_flow.cpp   the coarsest level: the flow from the start shell toward the
+//                             fitted points, one guarded step at a time, strays dropped;
+//   reconstruction_snap.cpp   every finer level (and a single one): the snap of the front onto
+//                             the local fits, pass after pass;
+//   reconstruction.cpp        validation, resolution and levels from the data, the levels in
+//                             order, the mesh.
+// Internal to levelset_core (namespace apps::detail). Units: world (the points centred on
+// their box). Threading: TBB inside each part; results do not depend on the thread count.
+#pragma once
+
+#include <chrono>
+#include <vector>
+
+#include "apps/point_distance.hpp"
+#include "apps/reconstruction.hpp"
+#include "core/progress.hpp"
+#include "grid/band_accessor.hpp"
+#include "grid/narrow_band.hpp"
+
+namespace levelset::apps::detail {
+
+using Clock = std::chrono::steady_clock;
+inline double seconds_since(Clock::time_point t0) {
+  return std::chrono::duration<double>(Clock::now() - t0).count();
+}
+
+// ---- reconstruction_grid.cpp
+// The band with its frame moved by `offset` and its half-width set to `half_width` voxels
+// (values, active voxels and signs unchanged).
+NarrowBand reframed(const NarrowBand& band, const Vec3d& offset, double half_width);
+// Start band on the coarsest level: the outer component of {d < offset} (see the header).
+NarrowBand start_shell(const PointIndex& index, const BBox& box, const Vec3d& origin, double h, double offset,
+                       double half_width, const ProgressHook& progress);
+// A per-voxel field of `coarse` (band value order) at voxel c of the grid with half its voxel
+// size and the same origin: the mean of the 1, 2, 4 or 8 coarse voxels around c / 2; NaN when
+// one of them is not active.
+double coarse_field_at(BandAccessor& acc, const NarrowBand& coarse, const std::vector<float>& field, const Coord& c);
+// The field at voxel c of `band` itself (NaN when c is not active).
+double field_at(BandAccessor& acc, const NarrowBand& band, const std::vector<float>& field, const Coord& c);
+// The next level's band: `coarse` at half the voxel size, half-width `half_width` voxels.
+NarrowBand upsample(const NarrowBand& coarse, double half_width, const ProgressHook& progress);
+
+// ---- reconstruction_flow.cpp
+// The coarsest level's flow from the start shell `band` (voxel size h) toward the points'
+// fits: the stage's flow fields (steps, change, refused flips, dropped components, seconds)
+// filled in; progress reported as a share of `levels` levels.
+struct LevelOutput {
+  NarrowBand band;
+  ReconstructionStage stage;
+};
+LevelOutput flow_level(NarrowBand band, const PointIndex& index, const ReconstructionOptions& o, int levels,
+                       ReconstructionStage stage);
+
+// ---- reconstruction_snap.cpp
+// The last snap pass's noise estimates, in final voxels (they choose the next level's fits).
+struct SnapNoise {
+  double noise = 0.0;         // the fits' spread
+  double height_noise = 0.0;  // the height fits' residual (no sagitta)
+};
+struct SnapLevel {
+  int level = 0, levels = 1;
+  double h_final = 0.0;
+};
+struct SnapOutput {
+  NarrowBand band;
+  ReconstructionStage stage;
+  SnapNoise noise;
+};
+// Level `where.level` (voxel size stage.voxel_size): `coarse` upsampled (level > 0; on a
+// single level the flow's band as it is), then snapped onto the fits pass after pass.
+SnapOutput snap_level(NarrowBand coarse, const PointIndex& index, const ReconstructionOptions& o,
+                      const SnapLevel& where, ReconstructionStage stage, SnapNoise previous);
+
+}  // namespace levelset::apps::detail
