@@ -71,29 +71,27 @@ void add_download_commands(CLI::App& app, Globals& g) {
                          Api::encode(m->method) + "&iso=" + Api::encode(iso),
                      m->output);
   });
-  auto b = std::make_shared<DownloadArgs>();
-  CLI::App* band = dl->add_subcommand("band", "The committed band as an .lsg file");
-  band->add_option("session", b->session, "Session id")->required();
-  band->add_option("-o,--output", b->output, "Output file (.lsg)")->required();
-  band->callback([b, &g] {
-    if (lower_extension(b->output) != "lsg")
-      throw ClientError(ClientError::Kind::Usage, "unknown_format", "a band is written as .lsg, not '" + b->output + "'");
-    g.api().download("/api/v1/sessions/" + Api::encode(b->session) + "/band", b->output);
-  });
-  auto r = std::make_shared<DownloadArgs>();
-  CLI::App* roi = dl->add_subcommand("roi", "The region of influence as an .lsg file");
-  roi->add_option("session", r->session, "Session id")->required();
-  roi->add_option("-o,--output", r->output, "Output file (.lsg)")->required();
-  roi->callback([r, &g] {
-    if (lower_extension(r->output) != "lsg")
-      throw ClientError(ClientError::Kind::Usage, "unknown_format", "a band is written as .lsg, not '" + r->output + "'");
-    g.api().download("/api/v1/sessions/" + Api::encode(r->session) + "/roi", r->output);
-  });
-  auto p = std::make_shared<DownloadArgs>();
-  CLI::App* points = dl->add_subcommand("points", "The session's point cloud, as uploaded (sessions show: points.format)");
-  points->add_option("session", p->session, "Session id")->required();
-  points->add_option("-o,--output", p->output, "Output file")->required();
-  points->callback([p, &g] { g.api().download("/api/v1/sessions/" + Api::encode(p->session) + "/points", p->output); });
+  // download band | roi | points SESSION -o FILE: a session's file as the API gives it; the
+  // bands are .lsg.
+  struct FileRoute {
+    const char *name, *route, *help, *output_help;
+    bool lsg;
+  };
+  for (const FileRoute& f : {FileRoute{"band", "band", "The committed band as an .lsg file", "Output file (.lsg)", true},
+                             FileRoute{"roi", "roi", "The region of influence as an .lsg file", "Output file (.lsg)", true},
+                             FileRoute{"points", "points", "The session's point cloud, as uploaded (sessions show: points.format)",
+                                       "Output file", false}}) {
+    auto args = std::make_shared<DownloadArgs>();
+    CLI::App* sub = dl->add_subcommand(f.name, f.help);
+    sub->add_option("session", args->session, "Session id")->required();
+    sub->add_option("-o,--output", args->output, f.output_help)->required();
+    sub->callback([args, f, &g] {
+      if (f.lsg && lower_extension(args->output) != "lsg")
+        throw ClientError(ClientError::Kind::Usage, "unknown_format",
+                          "a band is written as .lsg, not '" + args->output + "'");
+      g.api().download("/api/v1/sessions/" + Api::encode(args->session) + "/" + f.route, args->output);
+    });
+  }
 }
 
 }  // namespace levelset::client

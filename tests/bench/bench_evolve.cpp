@@ -115,19 +115,28 @@ bool bench_band(const NarrowBand& band, int runs, int steps, int long_steps, ben
 // [-1, 1]^3 at N^3, band width 12 (half-width 6), six mean-Gaussian steps and one
 // reinitialisation the thesis's way (marching cubes of the zero level, then the closest point
 // transform of that mesh), plus ours (redistance, no mesh). Seconds per column.
+// Table 5.1's input: a sphere of radius 0.8 in [-1, 1]^3 at N^3, band half-width 6 voxels.
+NarrowBand table_5_1_sphere(int n) {
+  SdfBuildOptions build;
+  build.frame = GridFrame{2.0 / n, {-1.0, -1.0, -1.0}, 6.0};
+  const BBox box{{-0.8, -0.8, -0.8}, {0.8, 0.8, 0.8}};
+  return build_from_sdf([](const Vec3d& p) { return length(p) - 0.8; }, box, build).band;
+}
+
+// Its work: six mean-Gaussian steps.
+evolve::EvolutionOptions table_5_1_flow() {
+  evolve::EvolutionOptions o;
+  o.speed = evolve::mean_gaussian_flow();
+  o.steps = 6;
+  return o;
+}
+
 // Table 5.1's work at N = 256 with 2 threads, as the daemon runs it: six mean-Gaussian steps
 // and our redistance (no mesh). Returns seconds (best of `runs`).
 double table_5_1_two_threads(int n, int runs) {
   tbb::global_control limit(tbb::global_control::max_allowed_parallelism, 2);
-  const double h = 2.0 / n;
-  SdfBuildOptions build;
-  build.frame = GridFrame{h, {-1.0, -1.0, -1.0}, 6.0};
-  const BBox box{{-0.8, -0.8, -0.8}, {0.8, 0.8, 0.8}};
-  const NarrowBand band = build_from_sdf([](const Vec3d& p) { return length(p) - 0.8; }, box, build).band;
-  evolve::EvolutionOptions o;
-  o.speed = evolve::mean_gaussian_flow();
-  o.steps = 6;
-  return best_of(runs, [&] { redistance(evolve::evolve(band, o).band, RedistanceOptions{}); });
+  const NarrowBand band = table_5_1_sphere(n);
+  return best_of(runs, [&] { redistance(evolve::evolve(band, table_5_1_flow()).band, RedistanceOptions{}); });
 }
 
 void table_5_1(bool quick) {
@@ -144,20 +153,13 @@ void table_5_1(bool quick) {
               "marching cubes", "closest point", "function", "other", "total", "redistance");
   for (const Thesis& t : thesis) {
     if (quick && t.n > 32) break;
-    const double h = 2.0 / t.n;
-    SdfBuildOptions build;
-    build.frame = GridFrame{h, {-1.0, -1.0, -1.0}, 6.0};
-    const BBox box{{-0.8, -0.8, -0.8}, {0.8, 0.8, 0.8}};
-    const NarrowBand band = build_from_sdf([](const Vec3d& p) { return length(p) - 0.8; }, box, build).band;
-    evolve::EvolutionOptions o;
-    o.speed = evolve::mean_gaussian_flow();
-    o.steps = 6;
-    const evolve::EvolutionResult r = evolve::evolve(band, o);
+    const NarrowBand band = table_5_1_sphere(t.n);
+    const evolve::EvolutionResult r = evolve::evolve(band, table_5_1_flow());
     const auto t0 = std::chrono::steady_clock::now();
     const SurfaceResult surface = marching_cubes(r.band);
     const auto t1 = std::chrono::steady_clock::now();
     CptOptions cpt;
-    cpt.frame = build.frame;
+    cpt.frame = band.frame();
     const NarrowBand rebuilt = closest_point_transform(surface.mesh, cpt).band;
     const auto t2 = std::chrono::steady_clock::now();
     RedistanceOptions ro;

@@ -134,13 +134,18 @@ def red_pixels(path, box):
                if px[x, y][0] > 180 and px[x, y][1] < 140 and px[x, y][2] < 140)
 
 
-def scenario_workflow():
-    check(os.path.isfile(KNOT), "no knot.off at " + KNOT)
+def with_daemon(body):
+    """Runs body(daemon) against a fresh daemon on a loopback port, stopped afterwards."""
     daemon = Daemon(LEVELSETD, os.path.join(SCRATCH, "data"))
     try:
-        workflow_with(daemon)
+        body(daemon)
     finally:
         daemon.stop()
+
+
+def scenario_workflow():
+    check(os.path.isfile(KNOT), "no knot.off at " + KNOT)
+    with_daemon(workflow_with)
 
 
 def workflow_with(daemon):
@@ -232,11 +237,7 @@ def workflow_with(daemon):
 
 
 def scenario_sessions():
-    daemon = Daemon(LEVELSETD, os.path.join(SCRATCH, "data"))
-    try:
-        sessions_with(daemon)
-    finally:
-        daemon.stop()
+    with_daemon(sessions_with)
 
 
 def sessions_with(daemon):
@@ -299,11 +300,7 @@ def sessions_with(daemon):
 
 
 def scenario_roi():
-    daemon = Daemon(LEVELSETD, os.path.join(SCRATCH, "data"))
-    try:
-        roi_with(daemon)
-    finally:
-        daemon.stop()
+    with_daemon(roi_with)
 
 
 def roi_with(daemon):
