@@ -1,28 +1,22 @@
+// evolve(): the step loop (time step, Runge-Kutta stages, land mines, the edge layer, band
+// upkeep, redistancing, stop rules); the spatial operator is in evolution_operator.cpp.
 #include "evolve/evolution.hpp"
 
 #include <algorithm>
-#include <array>
 #include <atomic>
 #include <chrono>
 #include <cmath>
 #include <limits>
-#include <memory>
-#include <span>
 #include <sstream>
 
 #include <tbb/blocked_range.h>
-#include <tbb/combinable.h>
-#include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
 
 #include "core/error.hpp"
 #include "core/text.hpp"
 #include "distance/redistance.hpp"
 #include "evolve/band_tracking.hpp"
-#include "evolve/curvature.hpp"
-#include "grid/band_accessor.hpp"
-#include "grid/interpolate.hpp"
-#include "grid/tile.hpp"
+#include "evolve/evolution_operator.hpp"
 
 namespace levelset::evolve {
 
@@ -31,585 +25,10 @@ thread_local const std::function<void(const StepInfo&)>* t_step_observer = nullp
 
 namespace {
 
+using namespace detail;
 using Clock = std::chrono::steady_clock;
 double since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
-
-// Dense tile around one brick: the brick plus kStencilReach voxels on every side.
-constexpr int kLo = -kStencilReach, kHi = kBrickDim + kStencilReach, kDim = kHi - kLo;
-constexpr std::ptrdiff_t kStride[3] = {1, kDim, kDim * kDim};
-constexpr int tile_index(int x, int y, int z) { return (x - kLo) + kDim * ((y - kLo) + kDim * (z - kLo)); }
 constexpr double kSqrt3 = 1.7320508075688772;
-
-// Per-thread buffers for one brick (at most 512 active voxels).
-struct Scratch {
-  std::vector<float> tile = std::vector<float>(std::size_t(kDim) * kDim * kDim);
-  std::vector<std::uint32_t> rows = std::vector<std::uint32_t>(std::size_t(kDim) * kDim);
-  std::array<float, kBrickVoxels> d, x, y, z, nx, ny, nz, mean, gauss, k1, k2, grad, beta_a, beta_p;
-  std::array<float, kBrickVoxels> dist, dgx, dgy, dgz, dn, img, edge, roi;
-  std::array<std::array<OneSided, 3>, kBrickVoxels> os;
-  std::unique_ptr<struct AxisLines> lines;
-  std::array<Vec3d, kBrickVoxels> vel;
-  std::array<int, kBrickVoxels> curvature_at_tile;  // tile index whose curvature a voxel takes; -1: none
-};
-
-bool active_at(const Scratch& s, int x, int y, int z) {
-  return (s.rows[std::size_t((y - kLo) + kDim * (z - kLo))] >> (x - kLo)) & 1u;
-}
-
-// The band's edge layer is not evolved by the PDE (its stencils read +-W h beyond the band):
-// after each step an edge voxel takes the polynomial extrapolation of the new values along
-// the axis direction where u changes fastest: sum of coef[k] * u[source[k]].
-struct EdgeStencil {
-  std::uint32_t target = 0;
-  std::uint8_t count = 0;
-  std::array<std::uint32_t, 3> source{};
-  std::array<float, 3> coef{};
-  // The active 6-neighbours: a distance changes by at most h per voxel, so the result is
-  // clamped to the range they allow (a polynomial through a kink could leave it).
-  std::uint8_t neighbors = 0;
-  std::array<std::uint32_t, 6> neighbor{};
-};
-
-// Whether the 19-point curvature stencil around tile position p (centre, faces, edges) is
-// all active: inactive samples hold +-W h, not the field, and a curvature read through them is
-// wrong by up to 1 / (2 h).
-bool curvature_stencil_active(const Scratch& s, const Coord& p) {
-  auto row = [&](int y, int z) { return s.rows[std::size_t((y - kLo) + kDim * (z - kLo))] >> (p.x - 1 - kLo); };
-  constexpr std::uint32_t three = 7u, middle = 2u;
-  if ((row(p.y, p.z) & three) != three) return false;
-  for (int d = -1; d <= 1; d += 2) {
-    if ((row(p.y + d, p.z) & three) != three || (row(p.y, p.z + d) & three) != three) return false;
-    if (!(row(p.y + d, p.z - 1) & middle) || !(row(p.y + d, p.z + 1) & middle)) return false;
-  }
-  return true;
-}
-
-// Where a voxel takes its curvature from (a tile index), or -1. Near the band's edge the
-// stencil reads inactive samples; there the voxel takes the curvature of the first voxel
-// with a whole stencil on the way toward the front (stepping to the active 6-neighbour of
-// smallest |u|, at most 3 steps). Level sets of a distance function are parallel, so that
-// is the curvature of a neighbouring level set, off by O(h k^2); a garbage curvature here
-// fed the parabolic part with rates of 1 / h and made the band drift and grow (issue 13).
-// -1 (no curvature) where no such voxel is near (a band too thin for the stencil).
-int curvature_source(const Scratch& s, const Coord& l) {
-  Coord p = l;
-  for (int hop = 0;; ++hop) {
-    if (curvature_stencil_active(s, p)) return tile_index(p.x, p.y, p.z);
-    if (hop == 3) return -1;
-    const float here = std::abs(s.tile[std::size_t(tile_index(p.x, p.y, p.z))]);
-    Coord best = p;
-    float best_value = here;
-    for (int f = 0; f < 6; ++f) {
-      Coord q = p;
-      q[f >> 1] += (f & 1) ? 1 : -1;
-      if (q[f >> 1] <= kLo || q[f >> 1] >= kHi - 1 || !active_at(s, q.x, q.y, q.z)) continue;
-      const float v = std::abs(s.tile[std::size_t(tile_index(q.x, q.y, q.z))]);
-      if (v < best_value) {
-        best_value = v;
-        best = q;
-      }
-    }
-    if (best == p) return -1;
-    p = best;
-  }
-}
-
-bool is_edge(const Scratch& s, const Coord& l) {
-  for (int a = 0; a < 3; ++a)
-    for (int sgn = -1; sgn <= 1; sgn += 2) {
-      Coord q = l;
-      q[a] += sgn;
-      if (!active_at(s, q.x, q.y, q.z)) return true;
-    }
-  return false;
-}
-
-// Band value index of the active voxel at brick-local coordinates q (within one brick of the
-// brick itself).
-std::uint32_t value_index(const NarrowBand& band, const Neighborhood& around, const Coord& q) {
-  const int bx = q.x < 0 ? -1 : (q.x >= kBrickDim ? 1 : 0), by = q.y < 0 ? -1 : (q.y >= kBrickDim ? 1 : 0),
-            bz = q.z < 0 ? -1 : (q.z >= kBrickDim ? 1 : 0);
-  const Brick& br = band.bricks()[around[std::size_t(Neighborhood::slot(bx, by, bz))]];
-  return std::uint32_t(br.value_offset + std::uint32_t(br.slot(local_index(q.x & 7, q.y & 7, q.z & 7))));
-}
-
-// The extrapolation of edge voxel l from the interior (see EdgeStencil): quadratic through the
-// next three active voxels along a direction (linear through two), the first one not itself
-// an edge voxel, on the direction where u changes fastest.
-EdgeStencil edge_stencil(const NarrowBand& band, const Neighborhood& around, const Scratch& s, const Coord& l) {
-  EdgeStencil e;
-  double step = -1.0;
-  for (int f = 0; f < 6; ++f) {
-    const int a = f >> 1, dir = (f & 1) ? 1 : -1;
-    Coord q[3] = {l, l, l};
-    int n = 0;
-    for (; n < 3; ++n) {
-      q[n][a] += dir * (n + 1);
-      if (n + 1 > kStencilReach || !active_at(s, q[n].x, q[n].y, q[n].z)) break;
-    }
-    if (n < 2 || is_edge(s, q[0])) continue;
-    const float* t = s.tile.data();
-    const double u1 = t[tile_index(q[0].x, q[0].y, q[0].z)], u2 = t[tile_index(q[1].x, q[1].y, q[1].z)];
-    if (std::abs(u1 - u2) <= step) continue;
-    step = std::abs(u1 - u2);
-    e.count = std::uint8_t(n);
-    for (int k = 0; k < n; ++k) e.source[std::size_t(k)] = value_index(band, around, q[k]);
-    e.coef = n == 3 ? std::array<float, 3>{3.0f, -3.0f, 1.0f} : std::array<float, 3>{2.0f, -1.0f, 0.0f};
-  }
-  if (e.count > 0)
-    for (int f = 0; f < 6; ++f) {
-      Coord q = l;
-      q[f >> 1] += (f & 1) ? 1 : -1;
-      if (active_at(s, q.x, q.y, q.z)) e.neighbor[e.neighbors++] = value_index(band, around, q);
-    }
-  return e;
-}
-
-// Lines of samples along each axis through the brick's voxels, with the samples beyond the
-// band's edge (which hold +-W h, not values of the field) replaced by extrapolation from the
-// active samples of the line (quadratic through the last three, linear through two), so that
-// upwind stencils near the edge see a smooth field. line(a, i, j)[k] is the sample at
-// coordinate k - kStencilReach along axis a (k in [0, 14)), at (i, j) in [0, 8)^2 across.
-struct AxisLines {
-  static constexpr int kLen = kDim;
-  std::array<float, 3 * kBrickDim * kBrickDim * kLen> data{};
-  float* line(int a, int i, int j) { return data.data() + std::size_t(((a * kBrickDim + i) * kBrickDim + j) * kLen); }
-  const float* line(int a, int i, int j) const {
-    return data.data() + std::size_t(((a * kBrickDim + i) * kBrickDim + j) * kLen);
-  }
-};
-
-// Fills one line: `active` bit k says sample k is in the band.
-void extrapolate_line(float* v, std::uint32_t active, int reach) {
-  constexpr int n = AxisLines::kLen;
-  int k = 0;
-  while (k < n) {
-    if ((active >> k) & 1u) {
-      ++k;
-      continue;
-    }
-    // Inactive run [k, e).
-    int e = k;
-    while (e < n && !((active >> e) & 1u)) ++e;
-    const bool left = k > 0, right = e < n;
-    for (int g = k; g < e; ++g) {
-      const int dl = g - k + 1, dr = e - g;  // distance to the nearest active sample on each side
-      const bool from_left = left && (!right || dl <= dr);
-      if ((from_left ? dl : dr) > reach || (!left && !right)) continue;
-      const int dir = from_left ? 1 : -1, last = from_left ? k - 1 : e;  // last active sample
-      // Active samples behind `last`, away from the gap (at most 3).
-      int run = 1;
-      while (run < 3) {
-        const int q = last - dir * run;
-        if (q < 0 || q >= n || !((active >> q) & 1u)) break;
-        ++run;
-      }
-      const double p1 = v[last], p2 = run >= 2 ? v[last - dir] : p1, p3 = run >= 3 ? v[last - 2 * dir] : p2;
-      const double t = from_left ? dl : dr;  // steps beyond `last`
-      // Polynomial through (0, p1), (-1, p2), (-2, p3) evaluated at t.
-      double value = p1;
-      if (run == 2) value = p1 + t * (p1 - p2);
-      if (run >= 3) value = p1 + t * (1.5 * p1 - 2.0 * p2 + 0.5 * p3) + 0.5 * t * t * (p1 - 2.0 * p2 + p3);
-      v[g] = float(value);
-    }
-    k = e;
-  }
-}
-
-void fill_axis_lines(const Scratch& s, int reach, AxisLines& lines) {
-  constexpr int n = AxisLines::kLen;
-  constexpr std::uint32_t all = (1u << n) - 1, own = ((1u << kBrickDim) - 1) << (-kLo);  // brick samples
-  auto row = [&](int ty, int tz) { return s.rows[std::size_t(ty + kDim * tz)]; };  // tile-index rows
-  for (int i = 0; i < kBrickDim; ++i)
-    for (int j = 0; j < kBrickDim; ++j) {
-      const int ti = i - kLo, tj = j - kLo;
-      // x lines: (y, z) = (i, j): one row.
-      {
-        const std::uint32_t act = row(ti, tj);
-        if (act & own) {
-          float* l = lines.line(0, i, j);
-          std::copy_n(s.tile.data() + tile_index(kLo, i, j), n, l);
-          if (act != all) extrapolate_line(l, act, reach);
-        }
-      }
-      // y lines: (x, z) = (i, j); z lines: (x, y) = (i, j).
-      std::uint32_t ay = 0, az = 0;
-      for (int k = 0; k < n; ++k) {
-        ay |= ((row(k, tj) >> ti) & 1u) << k;
-        az |= ((row(tj, k) >> ti) & 1u) << k;
-      }
-      if (ay & own) {
-        float* l = lines.line(1, i, j);
-        for (int k = 0; k < n; ++k) l[k] = s.tile[std::size_t(tile_index(i, k + kLo, j))];
-        if (ay != all) extrapolate_line(l, ay, reach);
-      }
-      if (az & own) {
-        float* l = lines.line(2, i, j);
-        for (int k = 0; k < n; ++k) l[k] = s.tile[std::size_t(tile_index(i, j, k + kLo))];
-        if (az != all) extrapolate_line(l, az, reach);
-      }
-    }
-}
-
-// CPU seconds summed over threads, per phase of the spatial operator.
-struct OperatorSeconds {
-  double gradient = 0, curvature = 0, speed = 0, rates = 0;
-};
-
-struct OperatorSetup {
-  const EvolutionOptions& options;
-  double time = 0, kavg = 0;
-  const float* beta_a_override = nullptr;  // band value order (extension velocities)
-  const float* beta_p_override = nullptr;
-  bool want_edges = false;
-  bool want_betas = false;  // fill OperatorOutput::beta_a / beta_p
-};
-
-struct OperatorOutput {
-  std::vector<float> rate, beta_a, beta_p;
-  std::vector<std::uint8_t> edge;  // 1: an active voxel with an inactive 6-neighbour
-  std::vector<std::vector<EdgeStencil>> edge_stencils;  // per brick
-  double max_hyperbolic = 0, max_speed = 0, max_front_speed = 0, drift_sum = 0;
-  std::uint64_t drift_count = 0;
-  // Grid edges between 6-neighbours of opposite sign (want_edges only): a measure of the zero
-  // level's area, about A / h^2 times |n|_1, that does not depend on |grad u|.
-  std::uint64_t crossings = 0;
-  float min_value = 0, max_value = 0;  // over the active voxels (want_edges only)
-  OperatorSeconds seconds;
-};
-
-// One thread's share of the operator's reductions.
-struct OperatorStats {
-  double max_hyp = 0, max_speed = 0, max_front = 0, drift_sum = 0;
-  std::uint64_t drift_count = 0, crossings = 0;
-  float min_value = std::numeric_limits<float>::infinity(), max_value = -std::numeric_limits<float>::infinity();
-  OperatorSeconds seconds;
-};
-
-bool has_velocity(const EvolutionOptions& o) { return o.velocity.kind != Velocity::Kind::None; }
-bool has_speed(const EvolutionOptions& o) { return bool(o.speed.eval); }
-
-// The spatial operator on one brick: rates (and betas, edges) for its active voxels.
-void brick_operator(const NarrowBand& band, std::uint32_t b, const OperatorSetup& setup, Scratch& s,
-                    OperatorOutput& out, OperatorStats& stats) {
-  OperatorSeconds& out_seconds = stats.seconds;
-  const auto t_start = Clock::now();
-  const EvolutionOptions& o = setup.options;
-  const SpeedFunction& speed = o.speed;
-  const bool moving = has_speed(o);
-  const bool advective = moving && speed.has_advective;
-  const bool parabolic = moving && speed.has_parabolic;
-  const bool velocity = has_velocity(o);
-  const std::uint32_t needs = moving ? speed.needs : 0u;
-  const bool upwind = advective || velocity;
-  const bool advection_only = velocity && !advective && o.hamiltonian == Hamiltonian::Godunov;
-  const double h = band.voxel_size();
-  const Neighborhood around = brick_neighborhood(band, b);
-  gather_box(band, around, kLo, kHi, s.tile, s.rows);
-  if (upwind) {
-    if (!s.lines) s.lines = std::make_unique<AxisLines>();
-    fill_axis_lines(s, stencil_reach(o.scheme), *s.lines);
-  }
-  const Brick& br = band.bricks()[b];
-  const Coord origin = brick_origin(br.coord);
-  const std::size_t first = br.value_offset;
-  int k = 0;
-  br.active.for_each_set([&](int n) {
-    const Coord l = local_coord(n);
-    const float* v = s.tile.data() + tile_index(l.x, l.y, l.z);
-    s.d[std::size_t(k)] = *v;
-    Vec3d world{};
-    constexpr std::uint32_t kFieldNeeds = kNeedsDist | kNeedsDistGradient | kNeedsImage | kNeedsEdge | kNeedsRoi;
-    if ((needs & (kNeedsPosition | kFieldNeeds)) || (velocity && o.velocity.kind == Velocity::Kind::Field)) {
-      world = band.world(origin + l);
-      s.x[std::size_t(k)] = float(world.x);
-      s.y[std::size_t(k)] = float(world.y);
-      s.z[std::size_t(k)] = float(world.z);
-      const SpeedFields& f = o.fields;
-      const std::size_t u = std::size_t(k);
-      if (needs & kNeedsDist) s.dist[u] = float(f.dist(world));
-      if (needs & kNeedsDistGradient) {
-        const Vec3d g = f.dist_gradient(world);
-        s.dgx[u] = float(g.x);
-        s.dgy[u] = float(g.y);
-        s.dgz[u] = float(g.z);
-      }
-      if (needs & kNeedsImage) s.img[u] = float(f.image(world));
-      if (needs & kNeedsEdge) s.edge[u] = float(f.edge(world));
-      if (needs & kNeedsRoi) s.roi[u] = float(f.roi(world));
-    }
-    if (velocity)
-      s.vel[std::size_t(k)] = o.velocity.kind == Velocity::Kind::Constant ? o.velocity.constant
-                                                                          : o.velocity.field(world, setup.time);
-    if (upwind) {
-      const AxisLines& ln = *s.lines;
-      auto& d = s.os[std::size_t(k)];
-      const float* lines[3] = {ln.line(0, l.y, l.z) + (l.x - kLo), ln.line(1, l.x, l.z) + (l.y - kLo),
-                               ln.line(2, l.x, l.y) + (l.z - kLo)};
-      if (advection_only) {
-        // Pure advection upwinds each axis by the velocity's sign: one side is enough.
-        const Vec3d& vel = s.vel[std::size_t(k)];
-        for (int a = 0; a < 3; ++a) {
-          const bool minus = vel[a] > 0.0;
-          const double side = vel[a] != 0.0 ? one_side(lines[a], 1, o.scheme, minus) : 0.0;
-          d[std::size_t(a)] = minus ? OneSided{side, 0.0} : OneSided{0.0, side};
-        }
-      } else {
-        for (int a = 0; a < 3; ++a) d[std::size_t(a)] = one_sided(lines[a], 1, o.scheme);
-      }
-    }
-    // Central gradient: for the parabolic part, normals, |grad u| and the drift near the front.
-    const bool near = std::abs(*v) < 2 * h;
-    const bool want_grad = parabolic || near || (needs & (kNeedsNormal | kNeedsGradNorm));
-    Vec3d g{};
-    if (want_grad)
-      g = Vec3d{double(v[1]) - double(v[-1]), double(v[kDim]) - double(v[-kDim]),
-                double(v[kDim * kDim]) - double(v[-kDim * kDim])} * (0.5 / h);
-    const double gn = want_grad ? length(g) : 0.0;
-    if (needs & (kNeedsMean | kNeedsPrincipal)) s.curvature_at_tile[std::size_t(k)] = curvature_source(s, l);
-    s.grad[std::size_t(k)] = float(gn);
-    if (needs & kNeedsNormal) {
-      const Vec3d nrm = gn > 0 ? g / gn : Vec3d{};
-      s.nx[std::size_t(k)] = float(nrm.x);
-      s.ny[std::size_t(k)] = float(nrm.y);
-      s.nz[std::size_t(k)] = float(nrm.z);
-      if (needs & kNeedsDistGradient)
-        s.dn[std::size_t(k)] = float(double(s.dgx[std::size_t(k)]) * nrm.x + double(s.dgy[std::size_t(k)]) * nrm.y +
-                                     double(s.dgz[std::size_t(k)]) * nrm.z);
-    }
-    if (near) {
-      stats.drift_sum += std::abs(gn - 1.0);
-      ++stats.drift_count;
-    }
-    stats.min_value = std::min(stats.min_value, *v);
-    stats.max_value = std::max(stats.max_value, *v);
-    if (setup.want_edges)
-      stats.crossings += unsigned((v[0] < 0.0f) != (v[1] < 0.0f)) + unsigned((v[0] < 0.0f) != (v[kDim] < 0.0f)) +
-                         unsigned((v[0] < 0.0f) != (v[kDim * kDim] < 0.0f));
-    if (setup.want_edges && is_edge(s, l)) {
-      out.edge[first + std::size_t(k)] = 1;
-      EdgeStencil e = edge_stencil(band, around, s, l);
-      if (e.count > 0) {
-        e.target = std::uint32_t(first + std::size_t(k));
-        out.edge_stencils[b].push_back(e);
-      }
-    }
-    ++k;
-  });
-  const int count = k;
-  const auto t_curvature = Clock::now();
-  out_seconds.gradient += std::chrono::duration<double>(t_curvature - t_start).count();
-  if (needs & kNeedsPrincipal) {
-    for (int i = 0; i < count; ++i) {
-      const int at = s.curvature_at_tile[std::size_t(i)];
-      const Curvature c = at >= 0 ? curvature_at(s.tile.data() + at, kStride, h) : Curvature{};
-      s.mean[std::size_t(i)] = float(c.mean);
-      s.gauss[std::size_t(i)] = float(c.gauss);
-      s.k1[std::size_t(i)] = float(c.k1);
-      s.k2[std::size_t(i)] = float(c.k2);
-    }
-  } else if (needs & kNeedsMean) {
-    for (int i = 0; i < count; ++i) {
-      const int at = s.curvature_at_tile[std::size_t(i)];
-      s.mean[std::size_t(i)] = at >= 0 ? float(mean_curvature_at(s.tile.data() + at, kStride, h)) : 0.0f;
-    }
-  }
-  const auto t_speed = Clock::now();
-  out_seconds.curvature += std::chrono::duration<double>(t_speed - t_curvature).count();
-  if (moving) {
-    if (setup.beta_a_override) {
-      std::copy_n(setup.beta_a_override + first, count, s.beta_a.data());
-      std::copy_n(setup.beta_p_override + first, count, s.beta_p.data());
-    } else {
-      std::fill_n(s.beta_a.data(), count, 0.0f);
-      std::fill_n(s.beta_p.data(), count, 0.0f);
-      SpeedBatch batch;
-      batch.count = count;
-      batch.time = setup.time;
-      batch.h = h;
-      batch.kavg = setup.kavg;
-      batch.d = s.d.data();
-      if (needs & kNeedsPosition) {
-        batch.x = s.x.data();
-        batch.y = s.y.data();
-        batch.z = s.z.data();
-      }
-      if (needs & kNeedsNormal) {
-        batch.nx = s.nx.data();
-        batch.ny = s.ny.data();
-        batch.nz = s.nz.data();
-      }
-      if (needs & (kNeedsMean | kNeedsPrincipal)) batch.mean = s.mean.data();
-      if (needs & kNeedsPrincipal) {
-        batch.gauss = s.gauss.data();
-        batch.k1 = s.k1.data();
-        batch.k2 = s.k2.data();
-      }
-      if (needs & kNeedsGradNorm) batch.grad = s.grad.data();
-      if (needs & kNeedsDist) batch.dist = s.dist.data();
-      if (needs & kNeedsDistGradient) {
-        batch.dgx = s.dgx.data();
-        batch.dgy = s.dgy.data();
-        batch.dgz = s.dgz.data();
-        if (needs & kNeedsNormal) batch.dn = s.dn.data();
-      }
-      if (needs & kNeedsImage) batch.img = s.img.data();
-      if (needs & kNeedsEdge) batch.edge = s.edge.data();
-      if (needs & kNeedsRoi) batch.roi = s.roi.data();
-      speed.eval(batch, SpeedOutput{s.beta_a.data(), s.beta_p.data()});
-    }
-    if (setup.want_betas) {
-      std::copy_n(s.beta_a.data(), count, out.beta_a.data() + first);
-      std::copy_n(s.beta_p.data(), count, out.beta_p.data() + first);
-    }
-  }
-  const auto t_rates = Clock::now();
-  out_seconds.speed += std::chrono::duration<double>(t_rates - t_speed).count();
-  const bool llf = o.hamiltonian == Hamiltonian::LaxFriedrichs;
-  for (int i = 0; i < count; ++i) {
-    const std::size_t u = std::size_t(i);
-    const double ba = advective ? double(s.beta_a[u]) : 0.0;
-    const double bp = parabolic ? double(s.beta_p[u]) : 0.0;
-    const Vec3d vel = velocity ? s.vel[u] : Vec3d{};
-    double rate = 0.0;
-    if (upwind) {
-      const OneSided* d = s.os[u].data();
-      const double vw[3] = {vel.x, vel.y, vel.z};
-      if (llf) {
-        const double alpha[3] = {std::abs(ba) + std::abs(vw[0]), std::abs(ba) + std::abs(vw[1]),
-                                 std::abs(ba) + std::abs(vw[2])};
-        rate -= llf_hamiltonian(d, ba, vw, alpha) / h;
-      } else {
-        if (advective && ba != 0.0) rate -= ba * godunov_gradient_norm(d, ba) / h;
-        if (velocity) rate -= upwind_advection(d, vw) / h;
-      }
-    }
-    if (parabolic) rate -= bp * double(s.grad[u]);
-    out.rate[first + u] = float(rate);
-    const double vsum = std::abs(vel.x) + std::abs(vel.y) + std::abs(vel.z);
-    stats.max_hyp = std::max(stats.max_hyp, kSqrt3 * std::abs(ba) + vsum);
-    const double sp = std::abs(ba) + std::abs(bp) + length(vel);
-    stats.max_speed = std::max(stats.max_speed, sp);
-    // The front's speed: voxels next to the zero level only (curvatures blow up near the
-    // skeleton, deep in the band, without the front moving).
-    if (std::abs(s.d[u]) < 1.5 * h) stats.max_front = std::max(stats.max_front, sp);
-  }
-  out_seconds.rates += since(t_rates);
-}
-
-// Area-weighted mean of H over the zero level: sum of H delta(u) |grad u| / sum of
-// delta(u) |grad u| over the band, with the smeared delta of width 1.5 h.
-double mean_curvature_average(const NarrowBand& band) {
-  const double h = band.voxel_size(), eps = 1.5 * h;
-  struct Acc {
-    double num = 0, den = 0;
-  };
-  tbb::combinable<Acc> acc;
-  tbb::enumerable_thread_specific<Scratch> scratch;
-  tbb::parallel_for(tbb::blocked_range<std::uint32_t>(0, std::uint32_t(band.brick_count()), 16),
-                    [&](const tbb::blocked_range<std::uint32_t>& r) {
-    Scratch& s = scratch.local();
-    Acc& a = acc.local();
-    for (std::uint32_t b = r.begin(); b != r.end(); ++b) {
-      const Brick& br = band.bricks()[b];
-      const float* vals = band.values().data() + br.value_offset;
-      bool any = false;
-      for (int i = 0; i < br.active_count() && !any; ++i) any = std::abs(double(vals[i])) < eps;
-      if (!any) continue;
-      gather_box(band, b, kLo, kHi, s.tile, {});
-      br.active.for_each_set([&](int n) {
-        const Coord l = local_coord(n);
-        const float* v = s.tile.data() + tile_index(l.x, l.y, l.z);
-        const double u = *v;
-        if (std::abs(u) >= eps) return;
-        const Vec3d g{(double(v[1]) - double(v[-1])) / (2 * h), (double(v[kDim]) - double(v[-kDim])) / (2 * h),
-                      (double(v[kDim * kDim]) - double(v[-kDim * kDim])) / (2 * h)};
-        const double w = (1.0 + std::cos(3.141592653589793 * u / eps)) / (2 * eps) * length(g);
-        a.num += w * mean_curvature_at(v, kStride, h);
-        a.den += w;
-      });
-    }
-  });
-  const Acc total = acc.combine([](const Acc& x, const Acc& y) { return Acc{x.num + y.num, x.den + y.den}; });
-  return total.den > 0 ? total.num / total.den : 0.0;
-}
-
-OperatorOutput run_operator(const NarrowBand& band, const OperatorSetup& setup) {
-  OperatorOutput out;
-  out.min_value = std::numeric_limits<float>::infinity();
-  out.max_value = -std::numeric_limits<float>::infinity();
-  const std::size_t n = band.active_voxel_count();
-  out.rate.assign(n, 0.0f);
-  if (setup.want_betas) {
-    out.beta_a.assign(n, 0.0f);
-    out.beta_p.assign(n, 0.0f);
-  }
-  if (setup.want_edges) {
-    out.edge.assign(n, 0);
-    out.edge_stencils.resize(band.brick_count());
-  }
-  tbb::combinable<OperatorStats> stats;
-  tbb::enumerable_thread_specific<Scratch> scratch;
-  tbb::parallel_for(tbb::blocked_range<std::uint32_t>(0, std::uint32_t(band.brick_count()), 8),
-                    [&](const tbb::blocked_range<std::uint32_t>& r) {
-    Scratch& s = scratch.local();
-    OperatorStats& st = stats.local();
-    for (std::uint32_t b = r.begin(); b != r.end(); ++b)
-      brick_operator(band, b, setup, s, out, st);
-  });
-  stats.combine_each([&](const OperatorStats& st) {
-    out.max_hyperbolic = std::max(out.max_hyperbolic, st.max_hyp);
-    out.max_speed = std::max(out.max_speed, st.max_speed);
-    out.max_front_speed = std::max(out.max_front_speed, st.max_front);
-    out.seconds.gradient += st.seconds.gradient;
-    out.seconds.curvature += st.seconds.curvature;
-    out.seconds.speed += st.seconds.speed;
-    out.seconds.rates += st.seconds.rates;
-    out.drift_sum += st.drift_sum;
-    out.drift_count += st.drift_count;
-    out.crossings += st.crossings;
-    out.min_value = std::min(out.min_value, st.min_value);
-    out.max_value = std::max(out.max_value, st.max_value);
-  });
-  return out;
-}
-
-// Speeds extended from the zero level: each voxel takes the speeds at its closest point
-// x - u n (trilinear in the band's speeds; all 8 corners there are active for W >= 2).
-void extend_speeds(const NarrowBand& band, std::vector<float>& beta_a, std::vector<float>& beta_p) {
-  NarrowBand field_a = band, field_p = band;
-  std::vector<float> a = beta_a, p = beta_p;
-  field_a.swap_values(a);
-  field_p.swap_values(p);
-  const double h = band.voxel_size();
-  std::vector<float> ext_a(beta_a.size()), ext_p(beta_p.size());
-  tbb::enumerable_thread_specific<Scratch> scratch;
-  tbb::parallel_for(tbb::blocked_range<std::uint32_t>(0, std::uint32_t(band.brick_count()), 8),
-                    [&](const tbb::blocked_range<std::uint32_t>& r) {
-    Scratch& s = scratch.local();
-    BandAccessor acc_a(field_a), acc_p(field_p);
-    for (std::uint32_t b = r.begin(); b != r.end(); ++b) {
-      gather_box(band, b, kLo, kHi, s.tile, {});
-      const Brick& br = band.bricks()[b];
-      const Coord origin = brick_origin(br.coord);
-      std::size_t k = br.value_offset;
-      br.active.for_each_set([&](int n) {
-        const Coord l = local_coord(n);
-        const float* v = s.tile.data() + tile_index(l.x, l.y, l.z);
-        const Vec3d g{(double(v[1]) - double(v[-1])) / (2 * h), (double(v[kDim]) - double(v[-kDim])) / (2 * h),
-                      (double(v[kDim * kDim]) - double(v[-kDim * kDim])) / (2 * h)};
-        const double gn = length(g);
-        const Vec3d x = band.world(origin + l);
-        const Vec3d c = gn > 1e-12 ? x - g * (double(*v) / (gn * gn)) : x;
-        ext_a[k] = sample_trilinear(acc_a, field_a, c);
-        ext_p[k] = sample_trilinear(acc_p, field_p, c);
-        ++k;
-      });
-    }
-  });
-  beta_a.swap(ext_a);
-  beta_p.swap(ext_p);
-}
 
 void check_options(const NarrowBand& band, const EvolutionOptions& o) {
   auto bad = [](const std::string& why) { throw Error(ErrorCode::InvalidArgument, "evolve", why); };
@@ -670,6 +89,132 @@ std::string first_non_finite(const NarrowBand& band, const std::vector<float>& v
   return where;
 }
 
+void add_phases(EvolutionResult& result, const OperatorOutput& op) {
+  result.seconds.gradient_cpu += op.seconds.gradient;
+  result.seconds.curvature_cpu += op.seconds.curvature;
+  result.seconds.speed_cpu += op.seconds.speed;
+  result.seconds.rates_cpu += op.seconds.rates;
+}
+
+// One time step's values from `cur` and its rates `op` (forward Euler, or TVD-RK3 with two
+// more operator evaluations), retried with half the step while a sign changes in the edge
+// layer (a land mine: the band's edge holds no PDE), at most 5 times.
+struct Advanced {
+  std::vector<float> values;
+  bool mine = false;
+  double dt = 0;
+};
+Advanced advance(NarrowBand& cur, const OperatorOutput& op, const OperatorSetup& setup, double dt, int rk_order,
+                 EvolutionResult& result) {
+  const double t = setup.time;
+  std::vector<float> next;
+  bool mine = false;
+  for (int attempt = 0; attempt < 5; ++attempt) {
+    auto t1 = Clock::now();
+    const std::vector<float> u0(cur.values().begin(), cur.values().end());
+    next.resize(u0.size());
+    for_each_value(u0.size(), [&](std::size_t i) { next[i] = float(double(u0[i]) + dt * double(op.rate[i])); });
+    if (rk_order == 3) {
+      // Stages are evaluated on `cur` with its values swapped out and back (no band copy).
+      OperatorSetup s2 = setup;
+      s2.want_edges = false;
+      s2.want_betas = false;
+      cur.swap_values(next);  // cur holds u1, next holds u0
+      s2.time = t + dt;
+      auto t2 = Clock::now();
+      OperatorOutput o1 = run_operator(cur, s2);
+      cur.swap_values(next);  // back: next holds u1
+      add_phases(result, o1);
+      std::vector<float> r1 = std::move(o1.rate);
+      result.seconds.operator_eval += since(t2);
+      std::vector<float> u2(u0.size());
+      for_each_value(u0.size(), [&](std::size_t i) {
+        u2[i] = float(0.75 * u0[i] + 0.25 * (double(next[i]) + dt * double(r1[i])));
+      });
+      cur.swap_values(u2);  // cur holds u2
+      s2.time = t + 0.5 * dt;
+      t2 = Clock::now();
+      OperatorOutput o2 = run_operator(cur, s2);
+      cur.swap_values(u2);  // back
+      add_phases(result, o2);
+      std::vector<float> r2 = std::move(o2.rate);
+      result.seconds.operator_eval += since(t2);
+      for_each_value(u0.size(), [&](std::size_t i) {
+        next[i] = float(u0[i] / 3.0 + 2.0 / 3.0 * (double(u2[i]) + dt * double(r2[i])));
+      });
+    }
+    std::atomic<bool> fired{false};
+    for_each_value(u0.size(), [&](std::size_t i) {
+      if (op.edge[i] && ((u0[i] < 0.0f) != (next[i] < 0.0f))) fired.store(true, std::memory_order_relaxed);
+    });
+    mine = fired.load();
+    result.seconds.update += since(t1);
+    if (!mine || attempt == 4) break;
+    ++result.landmine_count;
+    dt *= 0.5;
+  }
+  return {std::move(next), mine, dt};
+}
+
+// The edge layer from the new interior values (EdgeStencil), on its own side only.
+void extrapolate_edge_layer(const NarrowBand& cur, const OperatorOutput& op, std::vector<float>& next) {
+  const double h = cur.voxel_size();
+  std::vector<std::vector<std::pair<std::uint32_t, float>>> edge_values(op.edge_stencils.size());
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, op.edge_stencils.size(), 64), [&](const tbb::blocked_range<std::size_t>& r) {
+    for (std::size_t b = r.begin(); b != r.end(); ++b)
+      for (const EdgeStencil& e : op.edge_stencils[b]) {
+        double v = 0;
+        for (int k = 0; k < e.count; ++k) v += double(e.coef[std::size_t(k)]) * double(next[e.source[std::size_t(k)]]);
+        const bool inside = cur.values()[e.target] < 0.0f;
+        if (inside != (v < 0.0)) continue;
+        double lo = 0.0, hi = std::numeric_limits<double>::infinity();
+        for (int k = 0; k < e.neighbors; ++k) {
+          const double un = next[e.neighbor[std::size_t(k)]];
+          if ((un < 0.0) != inside) continue;
+          lo = std::max(lo, std::abs(un) - h);
+          hi = std::min(hi, std::abs(un) + h);
+        }
+        const double mag = std::clamp(std::abs(v), lo, std::max(lo, hi));
+        edge_values[b].push_back({e.target, float(inside ? -mag : mag)});
+      }
+  });
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, edge_values.size(), 64), [&](const tbb::blocked_range<std::size_t>& r) {
+    for (std::size_t b = r.begin(); b != r.end(); ++b)
+      for (const auto& [i, v] : edge_values[b]) next[i] = v;
+  });
+}
+
+// Band upkeep (band_tracking.hpp): voxels within W h of the front activated, the others
+// retired; counted in the result.
+NarrowBand upkeep(const NarrowBand& band, double half_width, bool extrapolate_edge, EvolutionResult& result) {
+  TrackOptions track;
+  track.half_width = half_width;
+  track.extrapolate_edge = extrapolate_edge;
+  TrackResult tracked = track_band(band, track);
+  result.activated += tracked.activated;
+  result.retired += tracked.retired;
+  ++result.band_updates;
+  return std::move(tracked.band);
+}
+
+// What observers see after a step (result.steps, time and grad_drift already updated).
+StepInfo step_info(const EvolutionResult& result, const OperatorOutput& op, const NarrowBand& band, double dt,
+                   double elapsed) {
+  StepInfo info;
+  info.step = result.steps;
+  info.time = result.time;
+  info.dt = dt;
+  info.active_voxels = band.active_voxel_count();
+  info.max_speed = op.max_speed;
+  info.redistance_count = result.redistance_count;
+  info.landmine_count = result.landmine_count;
+  info.grad_drift = result.grad_drift;
+  info.elapsed_seconds = elapsed;
+  info.crossings = op.crossings;
+  info.band = &band;
+  return info;
+}
+
 }  // namespace
 
 EvolutionResult evolve(const NarrowBand& band, const EvolutionOptions& options) {
@@ -688,12 +233,6 @@ EvolutionResult evolve(const NarrowBand& band, const EvolutionOptions& options) 
   // and after each redistance, within what a fresh band can hold: 2W / sqrt(3) for a plane
   // along a cube diagonal to 2W + 1 along an axis); 0: measure at the next step.
   double fresh_ratio = 0;
-  auto add_phases = [&](const OperatorOutput& op) {
-    result.seconds.gradient_cpu += op.seconds.gradient;
-    result.seconds.curvature_cpu += op.seconds.curvature;
-    result.seconds.speed_cpu += op.seconds.speed;
-    result.seconds.rates_cpu += op.seconds.rates;
-  };
   for (int step = 1; step <= options.max_steps; ++step) {
     if (options.steps > 0 && step > options.steps) break;
     if (options.time > 0 && t >= options.time) break;
@@ -715,7 +254,7 @@ EvolutionResult evolve(const NarrowBand& band, const EvolutionOptions& options) 
     setup.want_betas = options.extension && has_speed(options);
     if (has_speed(options) && (options.speed.needs & kNeedsMeanAverage)) setup.kavg = mean_curvature_average(cur);
     OperatorOutput op = run_operator(cur, setup);
-    add_phases(op);
+    add_phases(result, op);
     if (setup.want_betas) {
       extend_speeds(cur, op.beta_a, op.beta_p);
       OperatorSetup ext = setup;
@@ -723,7 +262,7 @@ EvolutionResult evolve(const NarrowBand& band, const EvolutionOptions& options) 
       ext.beta_p_override = op.beta_p.data();
       std::vector<std::uint8_t> edge = std::move(op.edge);
       op = run_operator(cur, ext);
-      add_phases(op);
+      add_phases(result, op);
       op.edge = std::move(edge);
     }
     result.seconds.operator_eval += since(t0);
@@ -752,52 +291,10 @@ EvolutionResult evolve(const NarrowBand& band, const EvolutionOptions& options) 
     if (options.time > 0) dt = std::min(dt, options.time - t);
 
     // RK stages; land mines halve dt and retry.
-    std::vector<float> next;
-    bool mine = false;
-    for (int attempt = 0; attempt < 5; ++attempt) {
-      auto t1 = Clock::now();
-      const std::vector<float> u0(cur.values().begin(), cur.values().end());
-      next.resize(u0.size());
-      for_each_value(u0.size(), [&](std::size_t i) { next[i] = float(double(u0[i]) + dt * double(op.rate[i])); });
-      if (options.rk_order == 3) {
-        // Stages are evaluated on `cur` with its values swapped out and back (no band copy).
-        OperatorSetup s2 = setup;
-        s2.want_edges = false;
-        s2.want_betas = false;
-        cur.swap_values(next);  // cur holds u1, next holds u0
-        s2.time = t + dt;
-        auto t2 = Clock::now();
-        OperatorOutput o1 = run_operator(cur, s2);
-        cur.swap_values(next);  // back: next holds u1
-        add_phases(o1);
-        std::vector<float> r1 = std::move(o1.rate);
-        result.seconds.operator_eval += since(t2);
-        std::vector<float> u2(u0.size());
-        for_each_value(u0.size(), [&](std::size_t i) {
-          u2[i] = float(0.75 * u0[i] + 0.25 * (double(next[i]) + dt * double(r1[i])));
-        });
-        cur.swap_values(u2);  // cur holds u2
-        s2.time = t + 0.5 * dt;
-        t2 = Clock::now();
-        OperatorOutput o2 = run_operator(cur, s2);
-        cur.swap_values(u2);  // back
-        add_phases(o2);
-        std::vector<float> r2 = std::move(o2.rate);
-        result.seconds.operator_eval += since(t2);
-        for_each_value(u0.size(), [&](std::size_t i) {
-          next[i] = float(u0[i] / 3.0 + 2.0 / 3.0 * (double(u2[i]) + dt * double(r2[i])));
-        });
-      }
-      std::atomic<bool> fired{false};
-      for_each_value(u0.size(), [&](std::size_t i) {
-        if (op.edge[i] && ((u0[i] < 0.0f) != (next[i] < 0.0f))) fired.store(true, std::memory_order_relaxed);
-      });
-      mine = fired.load();
-      result.seconds.update += since(t1);
-      if (!mine || attempt == 4) break;
-      ++result.landmine_count;
-      dt *= 0.5;
-    }
+    const Advanced adv = advance(cur, op, setup, dt, options.rk_order, result);
+    std::vector<float> next = std::move(adv.values);
+    const bool mine = adv.mine;
+    dt = adv.dt;
     const std::string bad = first_non_finite(cur, next);
     if (!bad.empty()) {
       result.stop = StopReason::NonFinite;
@@ -808,42 +305,13 @@ EvolutionResult evolve(const NarrowBand& band, const EvolutionOptions& options) 
       break;
     }
     auto t3 = Clock::now();
-    // The edge layer from the new interior values (EdgeStencil), on its own side only.
-    std::vector<std::vector<std::pair<std::uint32_t, float>>> edge_values(op.edge_stencils.size());
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, op.edge_stencils.size(), 64), [&](const tbb::blocked_range<std::size_t>& r) {
-      for (std::size_t b = r.begin(); b != r.end(); ++b)
-        for (const EdgeStencil& e : op.edge_stencils[b]) {
-          double v = 0;
-          for (int k = 0; k < e.count; ++k) v += double(e.coef[std::size_t(k)]) * double(next[e.source[std::size_t(k)]]);
-          const bool inside = cur.values()[e.target] < 0.0f;
-          if (inside != (v < 0.0)) continue;
-          double lo = 0.0, hi = std::numeric_limits<double>::infinity();
-          for (int k = 0; k < e.neighbors; ++k) {
-            const double un = next[e.neighbor[std::size_t(k)]];
-            if ((un < 0.0) != inside) continue;
-            lo = std::max(lo, std::abs(un) - h);
-            hi = std::min(hi, std::abs(un) + h);
-          }
-          const double mag = std::clamp(std::abs(v), lo, std::max(lo, hi));
-          edge_values[b].push_back({e.target, float(inside ? -mag : mag)});
-        }
-    });
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, edge_values.size(), 64), [&](const tbb::blocked_range<std::size_t>& r) {
-      for (std::size_t b = r.begin(); b != r.end(); ++b)
-        for (const auto& [i, v] : edge_values[b]) next[i] = v;
-    });
+    extrapolate_edge_layer(cur, op, next);
     // Band upkeep once the front may have moved track_distance voxels since the last one.
     motion += op.max_front_speed * dt;
     cur.swap_values(next);
     TrackResult tracked;
     if (mine || motion >= options.track_distance * h) {
-      TrackOptions track;
-      track.half_width = half_width;
-      track.extrapolate_edge = false;  // done above, every step
-      tracked = track_band(cur, track);
-      result.activated += tracked.activated;
-      result.retired += tracked.retired;
-      ++result.band_updates;
+      tracked.band = upkeep(cur, half_width, false, result);  // the edge layer: done above, every step
       motion = 0;
     } else {
       tracked.band = std::move(cur);
@@ -872,18 +340,7 @@ EvolutionResult evolve(const NarrowBand& band, const EvolutionOptions& options) 
     result.steps = step;
     result.time = t;
     result.grad_drift = grad_drift;
-    StepInfo info;
-    info.step = step;
-    info.time = t;
-    info.dt = dt;
-    info.active_voxels = cur.active_voxel_count();
-    info.max_speed = op.max_speed;
-    info.redistance_count = result.redistance_count;
-    info.landmine_count = result.landmine_count;
-    info.grad_drift = grad_drift;
-    info.elapsed_seconds = since(start);
-    info.crossings = op.crossings;
-    info.band = &cur;
+    const StepInfo info = step_info(result, op, cur, dt, since(start));
     if (options.on_step) options.on_step(info);
     if (t_step_observer != nullptr) (*t_step_observer)(info);
     if (options.progress.on_progress) {
@@ -898,13 +355,7 @@ EvolutionResult evolve(const NarrowBand& band, const EvolutionOptions& options) 
   if (motion > 0) {
     // Leave a tidy band: every value within W h, every voxel within W h of the front active.
     auto t5 = Clock::now();
-    TrackOptions track;
-    track.half_width = half_width;
-    TrackResult tracked = track_band(cur, track);
-    result.activated += tracked.activated;
-    result.retired += tracked.retired;
-    ++result.band_updates;
-    cur = std::move(tracked.band);
+    cur = upkeep(cur, half_width, true, result);
     result.seconds.tracking += since(t5);
   }
   result.seconds.total = since(start);
