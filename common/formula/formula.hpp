@@ -68,8 +68,6 @@ class Workspace {
   std::vector<float> data_;
 };
 
-struct Instruction;
-
 class Program {
  public:
   Program();
