@@ -118,6 +118,28 @@ inline Curvature curvature_at(const float* v, const std::ptrdiff_t stride[3], do
   return out;
 }
 
+// Mean and Gaussian curvature without the principal ones: H by the trace form and
+// K = g^T adj(Hess) g / |g|^4 (Goldman 2005), adj the adjugate of the Hessian; both 0 when
+// |grad u| <= kMinGradNorm. Equal to curvature_at's mean and gauss up to rounding, with one
+// square root instead of three and no tangent basis.
+struct MeanGauss {
+  double mean = 0, gauss = 0;
+};
+inline MeanGauss mean_gauss_curvature_at(const float* v, const std::ptrdiff_t stride[3], double h) {
+  const detail::Derivs d = detail::central_derivs(v, stride, h);
+  const double g2 = dot(d.g, d.g);
+  const double gn = std::sqrt(g2);
+  if (!(gn > kMinGradNorm)) return {};
+  const double trace = d.xx + d.yy + d.zz;
+  const double ghg = dot(d.g, detail::hess_times(d, d.g));
+  const double axx = d.yy * d.zz - d.yz * d.yz, ayy = d.xx * d.zz - d.xz * d.xz, azz = d.xx * d.yy - d.xy * d.xy;
+  const double axy = d.xz * d.yz - d.xy * d.zz, axz = d.xy * d.yz - d.xz * d.yy, ayz = d.xy * d.xz - d.xx * d.yz;
+  const Vec3d& g = d.g;
+  const double gag = axx * g.x * g.x + ayy * g.y * g.y + azz * g.z * g.z +
+                     2.0 * (axy * g.x * g.y + axz * g.x * g.z + ayz * g.y * g.z);
+  return {(g2 * trace - ghg) / (g2 * gn), gag / (g2 * g2)};
+}
+
 // Mean curvature H = div(grad u / |grad u|) alone (trace form, no eigen-solve); 0 when
 // |grad u| <= kMinGradNorm. Equals curvature_at(v, stride, h).mean up to rounding.
 inline double mean_curvature_at(const float* v, const std::ptrdiff_t stride[3], double h) {

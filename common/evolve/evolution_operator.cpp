@@ -315,7 +315,7 @@ void brick_operator(const NarrowBand& band, std::uint32_t b, const OperatorSetup
       g = Vec3d{double(v[1]) - double(v[-1]), double(v[kDim]) - double(v[-kDim]),
                 double(v[kDim * kDim]) - double(v[-kDim * kDim])} * (0.5 / h);
     const double gn = want_grad ? length(g) : 0.0;
-    if (needs & (kNeedsMean | kNeedsPrincipal)) s.curvature_at_tile[std::size_t(k)] = curvature_source(s, l);
+    if (needs & (kNeedsMean | kNeedsPrincipal | kNeedsGauss)) s.curvature_at_tile[std::size_t(k)] = curvature_source(s, l);
     s.grad[std::size_t(k)] = float(gn);
     if (needs & kNeedsNormal) {
       const Vec3d nrm = gn > 0 ? g / gn : Vec3d{};
@@ -357,6 +357,13 @@ void brick_operator(const NarrowBand& band, std::uint32_t b, const OperatorSetup
       s.k1[std::size_t(i)] = float(c.k1);
       s.k2[std::size_t(i)] = float(c.k2);
     }
+  } else if (needs & kNeedsGauss) {
+    for (int i = 0; i < count; ++i) {
+      const int at = s.curvature_at_tile[std::size_t(i)];
+      const MeanGauss c = at >= 0 ? mean_gauss_curvature_at(s.tile.data() + at, kStride, h) : MeanGauss{};
+      s.mean[std::size_t(i)] = float(c.mean);
+      s.gauss[std::size_t(i)] = float(c.gauss);
+    }
   } else if (needs & kNeedsMean) {
     for (int i = 0; i < count; ++i) {
       const int at = s.curvature_at_tile[std::size_t(i)];
@@ -388,7 +395,8 @@ void brick_operator(const NarrowBand& band, std::uint32_t b, const OperatorSetup
         batch.ny = s.ny.data();
         batch.nz = s.nz.data();
       }
-      if (needs & (kNeedsMean | kNeedsPrincipal)) batch.mean = s.mean.data();
+      if (needs & (kNeedsMean | kNeedsPrincipal | kNeedsGauss)) batch.mean = s.mean.data();
+      if (needs & kNeedsGauss) batch.gauss = s.gauss.data();
       if (needs & kNeedsPrincipal) {
         batch.gauss = s.gauss.data();
         batch.k1 = s.k1.data();

@@ -29,7 +29,8 @@ std::uint32_t needs_of(const formula::Program& p) {
   if (p.uses_var(Var::x) || p.uses_var(Var::y) || p.uses_var(Var::z)) needs |= kNeedsPosition;
   if (p.uses_var(Var::nx) || p.uses_var(Var::ny) || p.uses_var(Var::nz)) needs |= kNeedsNormal;
   if (p.uses_var(Var::H)) needs |= kNeedsMean;
-  if (p.uses_var(Var::K) || p.uses_var(Var::k1) || p.uses_var(Var::k2)) needs |= kNeedsPrincipal;
+  if (p.uses_var(Var::k1) || p.uses_var(Var::k2)) needs |= kNeedsPrincipal;
+  else if (p.uses_var(Var::K)) needs |= kNeedsGauss;
   if (p.uses_var(Var::kavg)) needs |= kNeedsMeanAverage | kNeedsMean;
   if (p.uses_var(Var::grad)) needs |= kNeedsGradNorm;
   if (p.uses_var(Var::dist)) needs |= kNeedsDist;

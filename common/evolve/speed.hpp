@@ -39,6 +39,7 @@ enum SpeedNeeds : std::uint32_t {
   kNeedsImage = 1u << 8,      // img (field)
   kNeedsEdge = 1u << 9,       // edge (field)
   kNeedsRoi = 1u << 10,       // roi (field)
+  kNeedsGauss = 1u << 11,     // K (and H) without k1, k2: closed forms, no eigen-solve
 };
 
 // Fields a session may carry (thesis 4.9: the distance to a point cloud, an image, an edge

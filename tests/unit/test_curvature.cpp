@@ -1,6 +1,6 @@
 // Curvature from dense samples (evolve/curvature.hpp) against analytic answers: sphere,
 // cylinder, plane, torus, saddle, convergence order, degenerate gradient, and the agreement of
-// mean_curvature_at with curvature_at().mean.
+// mean_curvature_at with curvature_at().mean, and mean_gauss_curvature_at with its mean and gauss.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -65,6 +65,10 @@ Curvature both(const float* v, const std::ptrdiff_t stride[3], double h) {
   EXPECT_GE(c.k1, c.k2);
   const double scale = std::max({std::abs(c.k1), std::abs(c.k2), 1e-300});
   EXPECT_LE(std::abs(m - c.mean), 1e-9 * scale) << m << " vs " << c.mean;
+  // The closed forms without the eigen-solve (speeds reading K but not k1, k2).
+  const MeanGauss mg = mean_gauss_curvature_at(v, stride, h);
+  EXPECT_LE(std::abs(mg.mean - c.mean), 1e-9 * scale) << mg.mean << " vs " << c.mean;
+  EXPECT_LE(std::abs(mg.gauss - c.gauss), 1e-8 * scale * scale) << mg.gauss << " vs " << c.gauss;
   return c;
 }
 
@@ -318,6 +322,9 @@ TEST(Curvature, DegenerateGradientGivesZeros) {
     EXPECT_EQ(cv.k1, 0.0);
     EXPECT_EQ(cv.k2, 0.0);
     EXPECT_EQ(mean_curvature_at(v, stride, 0.5), 0.0);
+    const MeanGauss mg = mean_gauss_curvature_at(v, stride, 0.5);
+    EXPECT_EQ(mg.mean, 0.0);
+    EXPECT_EQ(mg.gauss, 0.0);
   };
   expect_zero(std::vector<float>(27, 0.75f));  // constant
   expect_zero(std::vector<float>(27, 0.0f));

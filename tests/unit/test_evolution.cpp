@@ -328,7 +328,7 @@ TEST(Evolution, FormulasEvolveLikeHandWrittenSpeeds) {
          for (int i = 0; i < b.count; ++i)
            o.parabolic[i] = -(b.mean[i] > 0 ? 1.0f : (b.mean[i] < 0 ? -1.0f : 0.0f)) * std::sqrt(std::max(b.gauss[i], 0.0f));
        },
-       kNeedsMean | kNeedsPrincipal, false, true, 0.5},
+       kNeedsMean | kNeedsGauss, false, true, 0.5},
       {"1-eps*H",
        [](const SpeedBatch& b, const SpeedOutput& o) {
          for (int i = 0; i < b.count; ++i) {
