@@ -85,6 +85,15 @@ try:
     stored = d.get(f"/api/v1/sessions/{sid}/view")[2]
     check(stored["shading"] == "wireframe" and stored["cloud"]["on"] is True, f"stored view: {stored}")
     wait.until(lambda _: driver.find_element(By.ID, "stream").screenshot_as_png != shown)
+    # The region of influence: stored from the page, shown through the view's roi setting.
+    driver.find_element(By.ID, "store-roi").click()
+    wait.until(lambda _: isinstance(d.get(f"/api/v1/sessions/{sid}")[2].get("roi"), dict))
+    wait.until(lambda _: "voxels" in driver.find_element(By.ID, "roi-info").text)
+    driver.find_element(By.CSS_SELECTOR, "[data-view=roi]").click()
+    wait.until(lambda _: (d.get(f"/api/v1/sessions/{sid}/view")[2].get("roi") or {}).get("on") is True)
+    driver.find_element(By.ID, "clear-roi").click()
+    wait.until(lambda _: d.get(f"/api/v1/sessions/{sid}")[2].get("roi") is None)
+    wait.until(lambda _: driver.find_element(By.ID, "roi-info").text == "")
     # A point cloud from this computer: uploaded, reconstructed into a session that shows it.
     cloud = write_sphere_cloud(os.path.join(SCRATCH, "ball.xyz"), 4000)
     driver.find_element(By.ID, "file").send_keys(cloud)
