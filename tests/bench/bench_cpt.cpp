@@ -1,11 +1,19 @@
 // bench_cpt: our closest point transform against OpenVDB's meshToLevelSet on the same mesh,
-// voxel size and band half-width (W = 3), with 1 and 2 threads. Prints both times, the ratio
-// ours / OpenVDB (target < 1 on every row) and both active voxel counts.
-// Usage: bench_cpt [--quick]   (--quick: knot.off at R = 64 only, for the ctest smoke run)
+// voxel size and band half-width W, at 2 threads (and 1 for the coarse W = 3 rows). Prints
+// both times, the ratio ours / OpenVDB per row (target <= 0.5x, issue 20) and both active
+// voxel counts, then one summary line per kind (coarse, dense): the worst ratio.
+// Columns: ours (exact, the default: scan or propagation with its exact pass, "method"), ours
+//   without the exact pass (--approximate, OpenVDB's kind of answer), OpenVDB, both ratios.
+// Rows: coarse CGAL meshes (knot, bunny) at R = 256 and 512, W = 3, 6, 12; dense meshes, where
+//   there is about one triangle per surface voxel as in scans and meshes extracted from grids:
+//   a marching-cubes sphere at R = 256 (588k triangles) and every CGAL mesh subdivided until
+//   it has as many triangles as surface voxels at R = 128, each for W = 3, 6, 12.
+// Usage: bench_cpt [--quick] [--dense-only]  (--quick: knot.off at R = 64 only, for ctest)
 // Exit code 1 if a mesh is missing in the full run or the two sides disagree grossly on the
 // band (active voxel counts more than 5% apart: OpenVDB's band is not exact, ours is).
 #include <cmath>
 #include <cstdio>
+#include <algorithm>
 #include <filesystem>
 #include <string>
 #include <vector>
@@ -16,41 +24,82 @@
 
 #include "bench_support.hpp"
 #include "distance/closest_point_transform.hpp"
+#include "core/error.hpp"
 #include "grid/build_from_sdf.hpp"
 #include "io/mesh_reader.hpp"
+#include "surface/marching_cubes.hpp"
+#include "../unit/mesh_subdivide.hpp"
 
 namespace {
 
 using namespace levelset;
 
-bool bench_mesh(const std::string& path, const std::vector<int>& resolutions, int runs) {
-  const TriangleMesh mesh = read_mesh(path).mesh;
-  const bench::VdbMesh vdb_input = bench::vdb_mesh(mesh);
-  bool ok = true;
-  for (int res : resolutions) {
-    for (int threads : {1, 2}) {
-      tbb::global_control limit(tbb::global_control::max_allowed_parallelism, threads);
-      CptOptions options;
-      options.frame = frame_for_resolution(mesh.bounds(), res, 3.0);
-      std::uint64_t ours_active = 0, vdb_active = 0;
-      const double ours = bench::best_of(runs, [&] {
-        ours_active = closest_point_transform(mesh, options).band.active_voxel_count();
-      });
-      auto xf = openvdb::math::Transform::createLinearTransform(options.frame.voxel_size);
-      const double vdb = bench::best_of(runs, [&] {
-        vdb_active = openvdb::tools::meshToLevelSet<openvdb::FloatGrid>(*xf, vdb_input.points,
-                                                                        vdb_input.triangles, 3.0f)
-                         ->activeVoxelCount();
-      });
-      std::printf("%-14s %5d %3d %9.3f %9.3f %7.3fx %10llu %10llu  %s\n",
-                  std::filesystem::path(path).filename().c_str(), res, threads, ours, vdb, ours / vdb,
-                  (unsigned long long)ours_active, (unsigned long long)vdb_active,
-                  ours < vdb ? "faster" : "SLOWER");
-      std::fflush(stdout);
-      const double diff = std::abs(double(ours_active) - double(vdb_active)) / double(vdb_active);
-      ok &= diff < 0.05;
-    }
+struct Row {
+  std::string name;
+  const TriangleMesh* mesh;
+  const bench::VdbMesh* vdb;
+  int resolution;
+  double half_width;
+  int threads;
+  int runs;
+  const char* kind;
+};
+
+bool bench_row(const Row& row, bench::RatioSummary& summary) {
+  tbb::global_control limit(tbb::global_control::max_allowed_parallelism, row.threads);
+  CptOptions options;
+  options.frame = frame_for_resolution(row.mesh->bounds(), row.resolution, row.half_width);
+  std::uint64_t ours_active = 0, vdb_active = 0;
+  double shell = 0;
+  const double ours = bench::best_of(row.runs, [&] {
+    const CptResult r = closest_point_transform(*row.mesh, options);
+    ours_active = r.band.active_voxel_count();
+    shell = r.exact_shell;
+  });
+  // Propagation without its exact pass (--approximate): OpenVDB's kind of answer.
+  CptOptions approximate = options;
+  approximate.exact_shell = 1.0;
+  approximate.exact = false;
+  const double approx = row.threads == 2 ? bench::best_of(row.runs, [&] { closest_point_transform(*row.mesh, approximate); }) : 0.0;
+  auto xf = openvdb::math::Transform::createLinearTransform(options.frame.voxel_size);
+  const double vdb = bench::best_of(row.runs, [&] {
+    vdb_active = openvdb::tools::meshToLevelSet<openvdb::FloatGrid>(*xf, row.vdb->points, row.vdb->triangles,
+                                                                    float(row.half_width))
+                     ->activeVoxelCount();
+  });
+  char label[160];
+  std::snprintf(label, sizeof label, "%s R=%d W=%g thr=%d", row.name.c_str(), row.resolution, row.half_width,
+                row.threads);
+  std::printf("%-24s %8zu %5d %4g %3d %6s %9.3f %9.3f %9.3f %7.3fx %7.3fx %10llu %10llu\n", row.name.c_str(),
+              row.mesh->triangles.size(), row.resolution, row.half_width, row.threads,
+              shell < row.half_width ? "prop" : "scan", ours, approx, vdb, ours / vdb, approx / vdb,
+              (unsigned long long)ours_active, (unsigned long long)vdb_active);
+  std::fflush(stdout);
+  if (row.threads == 2) {
+    summary.add(row.kind, 0.5, label, ours / vdb);
+    summary.add(std::string(row.kind) + " approximate", 0.5, label, approx / vdb);
   }
+  const double diff = std::abs(double(ours_active) - double(vdb_active)) / double(vdb_active);
+  return diff < 0.05;
+}
+
+// A sphere of radius 1 as marching cubes extracts it from an exact band at R = 256.
+TriangleMesh marching_cubes_sphere(int resolution) {
+  const BBox box{{-1, -1, -1}, {1, 1, 1}};
+  SdfBuildOptions build;
+  build.frame = frame_for_resolution(box, resolution, 3.0);
+  const NarrowBand band = build_from_sdf([](const Vec3d& p) { return length(p) - 1.0; }, box, build).band;
+  return marching_cubes(band).mesh;
+}
+
+bool bench_dense(const std::string& name, const TriangleMesh& coarse, int resolution,
+                 bench::RatioSummary& summary) {
+  const TriangleMesh mesh =
+      test::densify(coarse, frame_for_resolution(coarse.bounds(), resolution, 3.0).voxel_size);
+  const bench::VdbMesh vdb = bench::vdb_mesh(mesh);
+  bool ok = true;
+  for (double w : {3.0, 6.0, 12.0})
+    ok &= bench_row({name, &mesh, &vdb, resolution, w, 2, 1, "dense"}, summary);
   return ok;
 }
 
@@ -58,24 +107,53 @@ bool bench_mesh(const std::string& path, const std::vector<int>& resolutions, in
 
 int main(int argc, char** argv) {
   const bool quick = bench::is_quick(argc, argv);
+  bool dense_only = false;
+  for (int i = 1; i < argc; ++i) dense_only |= std::string(argv[i]) == "--dense-only";
   openvdb::initialize();
   const std::string data = std::string(LEVELSET_CGAL_DATA) + "/meshes/";
-  std::printf("bench_cpt: closest point transform vs OpenVDB %s meshToLevelSet, W = 3, best of %d\n",
-              openvdb::getLibraryAbiVersionString(), quick ? 1 : 3);
-  std::printf("%-14s %5s %3s %9s %9s %8s %10s %10s\n", "mesh", "R", "thr", "ours_s", "vdb_s",
-              "ratio", "our_active", "vdb_active");
+  std::printf("bench_cpt: closest point transform vs OpenVDB %s meshToLevelSet\n",
+              openvdb::getLibraryAbiVersionString());
+  std::printf("%-24s %8s %5s %4s %3s %6s %9s %9s %9s %8s %8s %10s %10s\n", "mesh", "tris", "R", "W", "thr", "method",
+              "ours_s", "approx_s", "vdb_s", "ratio", "approx", "our_active", "vdb_active");
+  bench::RatioSummary summary("bench_cpt");
   return bench::run_bench("bench_cpt", nullptr, [&] {
     bool ok = true;
-    for (const char* name : {"knot.off", "bunny00.off"}) {
-      const std::string path = data + name;
-      if (!std::filesystem::exists(path)) {
-        std::printf("%-14s missing: %s (run deploy/install-deps.sh)\n", name, path.c_str());
-        if (!quick) ok = false;
-        continue;
-      }
-      ok &= bench_mesh(path, quick ? std::vector<int>{64} : std::vector<int>{256, 512}, quick ? 1 : 3);
-      if (quick) break;
+    if (quick) {
+      const TriangleMesh mesh = read_mesh(data + "knot.off").mesh;
+      const bench::VdbMesh vdb = bench::vdb_mesh(mesh);
+      ok &= bench_row({"knot.off", &mesh, &vdb, 64, 3.0, 2, 1, "coarse"}, summary);
+      summary.print();
+      return ok;
     }
+    if (!dense_only)
+      for (const char* name : {"knot.off", "bunny00.off"}) {
+        const std::string path = data + name;
+        if (!std::filesystem::exists(path)) {
+          std::printf("%-24s missing: %s (run deploy/install-deps.sh)\n", name, path.c_str());
+          ok = false;
+          continue;
+        }
+        const TriangleMesh mesh = read_mesh(path).mesh;
+        const bench::VdbMesh vdb = bench::vdb_mesh(mesh);
+        for (int res : {256, 512})
+          for (int threads : {1, 2}) ok &= bench_row({name, &mesh, &vdb, res, 3.0, threads, 3, "coarse"}, summary);
+        for (double w : {6.0, 12.0}) ok &= bench_row({name, &mesh, &vdb, 256, w, 2, 3, "coarse"}, summary);
+      }
+    ok &= bench_dense("sphere (marching cubes)", marching_cubes_sphere(256), 256, summary);
+    std::vector<std::filesystem::path> files;
+    for (const auto& entry : std::filesystem::directory_iterator(data)) files.push_back(entry.path());
+    std::sort(files.begin(), files.end());
+    for (const auto& path : files) {
+      TriangleMesh mesh;
+      try {
+        mesh = read_mesh(path.string()).mesh;
+      } catch (const Error&) {
+        continue;  // not a mesh our readers take
+      }
+      if (mesh.triangles.empty()) continue;
+      ok &= bench_dense(path.filename().string(), mesh, 128, summary);
+    }
+    summary.print();
     return ok;
   });
 }
