@@ -65,12 +65,10 @@ int main(int argc, char** argv) {
   res_opt->excludes(vs_opt);
   cpt_cmd->add_option("--band,-b", cpt.band, "Band half-width in voxels")->transform(levelset::cli::in_range(1.0, 64.0));
   cpt_cmd->add_flag("--closest-points", cpt.closest_points, "Store the closest surface point per voxel");
-  cpt_cmd->add_option("--exact-shell", cpt.exact_shell,
-                      "Voxels from the mesh scanned exactly; closest triangles propagate beyond (>= the band: scan "
-                      "all; default: chosen from the mesh, the same values either way)")
-      ->transform(levelset::cli::in_range(0.5, 64.0));
-  cpt_cmd->add_flag("--approximate", cpt.approximate,
-                    "Skip the exact pass after the propagation: faster, up to ~0.15 h too far on rare voxels");
+  cpt_cmd->add_option("--method", cpt.method,
+                      "characteristic (polyhedra per face, edge and vertex), slab (each triangle's slab) or auto "
+                      "(the cheaper by an estimate); the same values either way")
+      ->check(CLI::IsMember({"auto", "characteristic", "slab"}));
   cpt_cmd->add_option("-o,--output", cpt.output, "Output .lsg file")->required()->check(levelset::cli::lsg_output());
   add_common_options(cpt_cmd, threads, cpt.stats);
 

@@ -11,7 +11,7 @@
 #include "core/error.hpp"
 #include "core/text.hpp"
 #include "distance/brick_triangle_lists.hpp"
-#include "distance/closest_triangle_propagation.hpp"
+#include "distance/characteristic_scan.hpp"
 #include "distance/inside_masks.hpp"
 #include "distance/membrane_band.hpp"
 #include "distance/orient_faces.hpp"
@@ -114,8 +114,8 @@ void scan_triangle(const Vec3d& a, const Vec3d& b, const Vec3d& c, std::uint32_t
   }
 }
 
-// The exact distances of every voxel within `radius` voxels of the mesh, per listed brick
-// (lists binned with that margin): each brick scan-converts its triangles' slabs.
+// The slab scan: the exact distances of every voxel within `radius` voxels of the mesh, per
+// listed brick (lists binned with that margin): each brick scan-converts its triangles' slabs.
 ClosestTriangleField scan_shell(const TriangleMesh& mesh, const BrickTriangleLists& lists,
                                 const GridFrame& frame, double radius, const ProgressHook& progress) {
   const std::size_t nb = lists.bricks.size();
@@ -206,25 +206,18 @@ std::vector<MembraneBrick> pack_bricks(const TriangleMesh& mesh, const ClosestTr
   return per_brick;
 }
 
-// The exact shell when the caller leaves it to us: both exact methods' costs estimated from the
-// mesh (constants measured on a 588k-triangle sphere at W = 6 and 12, 2 threads: the scan
-// ~3.7 ns per slab voxel of a triangle, propagation plus its exact pass ~4.7 us per band
-// voxel). The scan wins on coarse meshes and narrow bands, propagation on dense meshes with
-// wide bands (its work per voxel does not grow with W or the triangle density).
-double choose_shell(const TriangleMesh& mesh, const GridFrame& frame) {
-  const double h = frame.voxel_size, w = frame.half_width, depth = 2.0 * w + 1.0;
-  double slab_voxels = 0, area = 0;
-  for (const auto& f : mesh.triangles) {
-    const Vec3d &a = mesh.vertices[f[0]], &b = mesh.vertices[f[1]], &c = mesh.vertices[f[2]];
-    const Vec3d n = cross(b - a, c - a);
-    area += 0.5 * length(n);
-    const Vec3d an{std::abs(n.x), std::abs(n.y), std::abs(n.z)};
-    const int axis = an.x >= an.y ? (an.x >= an.z ? 0 : 2) : (an.y >= an.z ? 1 : 2);
-    const Vec3d extent = max(max(a, b), c) - min(min(a, b), c);
-    slab_voxels += (extent[(axis + 1) % 3] / h + depth) * (extent[(axis + 2) % 3] / h + depth) * depth;
-  }
-  const double band_voxels = area / (h * h) * depth;
-  return band_voxels * 4.7e-6 < slab_voxels * 3.7e-9 ? 1.0 : w;
+// The method when the caller leaves it to us. The slab scan's work grows with W^3 per triangle,
+// the characteristic scan's with the band's voxels (one to two evaluations each) plus a fixed
+// cost per polyhedron; the slab scan is cheaper only for narrow bands around coarse meshes
+// (measured at R = 256, W = 3, 2 threads: knot.off, 4k triangles, 0.23 s against 0.30 s;
+// bunny00.off, 75k triangles, 0.96 s against 0.69 s).
+CptMethod choose_method(const TriangleMesh& mesh, const GridFrame& frame) {
+  if (frame.half_width > 3.0) return CptMethod::characteristic;
+  double area = 0;
+  for (const auto& f : mesh.triangles)
+    area += 0.5 * length(cross(mesh.vertices[f[1]] - mesh.vertices[f[0]], mesh.vertices[f[2]] - mesh.vertices[f[0]]));
+  const double surface_voxels = area / (frame.voxel_size * frame.voxel_size);
+  return double(mesh.triangles.size()) < 0.25 * surface_voxels ? CptMethod::slab_scan : CptMethod::characteristic;
 }
 
 }  // namespace
@@ -245,50 +238,53 @@ CptResult closest_point_transform(const TriangleMesh& mesh, const CptOptions& op
   options.progress.step(0.05, "orient");
 
   t = Clock::now();
-  const double shell_radius = std::min(
-      options.exact_shell < 0 ? choose_shell(mesh, options.frame) : options.exact_shell, options.frame.half_width);
-  result.exact_shell = shell_radius;
+  const CptMethod method =
+      options.method == CptMethod::automatic ? choose_method(mesh, options.frame) : options.method;
+  result.method = method;
+  const bool slab = method == CptMethod::slab_scan;
+  // Bricks near the mesh with their triangles: the slab scan's (within W*h), or a shell within
+  // one voxel (every brick within sqrt(3)/2 h of a triangle) that the characteristic scan
+  // dilates and the signs use.
   BinTrianglesOptions bin;
   bin.frame = options.frame;
-  bin.margin = shell_radius * options.frame.voxel_size;
+  bin.margin = (slab ? options.frame.half_width : 1.0) * options.frame.voxel_size;
   bin.progress = options.progress;
-  const BrickTriangleLists lists = bin_triangles_to_bricks(mesh, bin);
+  BrickTriangleLists lists = bin_triangles_to_bricks(mesh, bin);
   result.brick_triangle_pairs = lists.triangles.size();
   result.seconds.bin = since(t);
   options.progress.step(0.15, "bin");
 
-  // Unsigned distances: the exact scan within the shell, then propagation to the band.
+  // Unsigned distances and closest triangles.
   t = Clock::now();
-  ClosestTriangleField shell = scan_shell(mesh, lists, options.frame, shell_radius, options.progress);
+  ClosestTriangleField field;
+  if (slab) {
+    field = scan_shell(mesh, lists, options.frame, options.frame.half_width, options.progress);
+  } else {
+    CharacteristicScanOptions scan;
+    scan.frame = options.frame;
+    scan.progress = options.progress;
+    CharacteristicScanResult scanned = characteristic_scan(mesh, lists.bricks, scan);
+    field = std::move(scanned.field);
+    result.polyhedra = scanned.polyhedra;
+    result.evaluations = scanned.evaluations;
+  }
   result.seconds.distance = since(t);
-  t = Clock::now();
-  PropagateOptions propagate;
-  propagate.frame = options.frame;
-  propagate.shell_radius = shell_radius;
-  propagate.exact = options.exact;
-  propagate.progress = options.progress;
-  PropagateResult spread = propagate_closest_triangles(mesh, std::move(shell), propagate);
-  result.propagation_layers = spread.layers;
-  result.propagation_evaluations = spread.evaluations;
-  result.propagation_corrected = spread.corrected + spread.rim_added;
-  result.seconds.propagate = since(t);
   options.progress.step(0.7, "distance");
 
   // Signs: winding numbers of the consistently oriented mesh, one mask per brick, over the
-  // band's bricks with their shell triangles (the masks need every triangle meeting a brick;
-  // those are all within the shell's margin).
+  // band's bricks with their triangles (the masks need every triangle meeting a brick; those
+  // are all within the lists' margin).
   t = Clock::now();
   const WindingNumberTree tree = build_winding_tree(oriented.mesh);
   InsideMasksOptions sign_options;
   sign_options.frame = options.frame;
   sign_options.progress = options.progress;
-  const bool propagated = shell_radius < options.frame.half_width;
-  BrickTriangleLists sign_lists = propagated ? band_brick_lists(spread.field, lists) : lists;
+  BrickTriangleLists sign_lists = slab ? std::move(lists) : band_brick_lists(field, lists);
   InsideMasksResult signs = compute_inside_masks(oriented.mesh, tree, sign_lists, sign_options);
-  if (signs.open_edges > 0 && propagated) {
+  if (signs.open_edges > 0 && !slab) {
     // Near open edges w also varies continuously, and the masks find the bricks that need
     // direct queries through the triangles listed within the band's margin: bin with it, as
-    // the full scan does, so open meshes get the same signs (and membranes) either way.
+    // the slab scan does, so open meshes get the same signs (and membranes) either way.
     bin.margin = options.frame.half_width * options.frame.voxel_size;
     sign_lists = bin_triangles_to_bricks(mesh, bin);
     signs = compute_inside_masks(oriented.mesh, tree, sign_lists, sign_options);
@@ -296,8 +292,8 @@ CptResult closest_point_transform(const TriangleMesh& mesh, const CptOptions& op
   result.winding_queries = signs.winding_queries;
   result.open_edges = signs.open_edges;
   const std::size_t nb = sign_lists.bricks.size();
-  std::vector<MembraneBrick> per_brick = pack_bricks(mesh, spread.field, sign_lists, options);
-  spread = PropagateResult{};
+  std::vector<MembraneBrick> per_brick = pack_bricks(mesh, field, sign_lists, options);
+  field = ClosestTriangleField{};
   for (std::size_t i = 0; i < nb; ++i) per_brick[i].inside = signs.inside[i];
   result.seconds.sign = since(t);
   options.progress.step(0.9, "sign");

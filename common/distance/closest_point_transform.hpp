@@ -15,23 +15,24 @@
 //   to the membrane) (close_membranes, membrane_band.hpp), so the zero level is closed and the
 //   band invariant holds; closest points there are the nearest membrane points (estimated).
 //   Closed meshes are untouched by this (bit for bit).
-// Method: (thesis 2.3.4, 4.5) triangles are binned to the bricks they come within the exact
-//   shell (options.exact_shell voxels, at most W) of; each brick scan-converts its triangles'
-//   slabs (|plane distance| <= shell, per column of the dominant axis) and keeps the minimum
-//   exact point-triangle distance per voxel (ties: lowest triangle index). No per-voxel loop
-//   over all triangles. With a shell thinner than W, the rest of the band gets its closest
-//   triangle by propagation from the shell in distance order (candidates from the neighbours,
-//   exact evaluation, a descent over the triangles around the best one:
-//   closest_triangle_propagation.hpp), whose work per voxel does not grow with W or the
-//   triangle density. Sign: faces are oriented
+// Method: (thesis 2.3.4, 4.5; Mauch's CPT, which the thesis's CPT library used) every voxel
+//   gets the minimum exact point-triangle distance over the triangles whose characteristic
+//   polyhedra contain it: the prism of each face, the wedge of each edge, the cone of each
+//   vertex, scan-converted column by column (characteristic_scan.hpp); about one to two
+//   evaluations per band voxel on smooth meshes, whatever W and the triangle density. The slab
+//   scan instead bins triangles to the bricks they come within W*h of and scan-converts each
+//   triangle's slab (|plane distance| <= W*h) per brick: the same values (the tests compare
+//   them on every CGAL mesh), W^3 work per triangle, cheaper only for narrow bands around
+//   coarse meshes (options.method chooses; automatic by a cost estimate). Ties: lowest
+//   triangle index. No per-voxel loop over all triangles. Sign: faces are oriented
 //   consistently (orient_faces), then every voxel of every brick gets the generalized winding
 //   number test (> 1/2 is inside) from one hierarchical evaluation per brick plus signed
 //   crossings along grid edges (compute_inside_masks) — robust for holes, open boundaries,
 //   self-intersections and flipped faces (thesis open issue 5.3). Then, for open meshes only,
 //   the membranes (membrane_band.hpp).
-// Cost: O(triangles * slab voxels per triangle) for the scan (the slab is the shell's: ~W^3 per
-//   triangle by default), plus O(band voxels * (26 + candidates)) for the propagation.
-// Threading: TBB over triangles and bricks; bit-identical results for any thread count.
+// Cost: characteristic: O(band voxels + triangles * columns per polyhedron); slab scan:
+//   O(triangles * (triangle size + 2W)^2 * 2W).
+// Threading: TBB over triangles and bricks; identical results for any thread count.
 // Errors: Error{InvalidArgument} for an empty mesh or bad indices, Error{NonFinite} for NaN or
 //   Inf vertices, Error{LimitExceeded} when the mesh needs more than options.max_domain_voxels
 //   (the voxel budget) or leaves the index range; Error{Cancelled} via the progress hook.
@@ -46,39 +47,33 @@
 
 namespace levelset {
 
+enum class CptMethod {
+  automatic,       // the characteristic scan, or the slab scan where it is estimated cheaper
+  slab_scan,       // every triangle's slab within W*h (thesis 2.3.4): W^3 work per triangle
+  characteristic,  // characteristic polyhedra (characteristic_scan.hpp): O(band voxels)
+};
+
 struct CptOptions {
   GridFrame frame;
   bool closest_points = false;
-  // Voxels: distances up to this far from the mesh come from the slab scan, the rest of the
-  // band from closest-triangle propagation (closest_triangle_propagation.hpp) then, when
-  // `exact`, a nearest-triangle query per propagated voxel bounded by its propagated distance
-  // (exact: the same values as the scan). A value >= W scans the whole band. Negative (the
-  // default): 1 or W, whichever the costs estimated from the mesh favour (the scan on coarse
-  // meshes and narrow bands; propagation on dense meshes with wide bands, measured 1.8x
-  // faster on a 588k-triangle sphere at W = 12). Both choices give the same values.
-  double exact_shell = -1.0;
-  // false: propagation only, 1.5-3x faster beyond the shell but not exact there (measured on
-  // CGAL's closed meshes at W = 6: up to 0.15 h too far on 0.5 % of those voxels; smooth
-  // meshes: none), and a voxel near the band's rim can be missed (test_cpt_propagation).
-  bool exact = true;
+  CptMethod method = CptMethod::automatic;
   // Voxel budget: the mesh's bounding box padded by the band, in voxels.
   std::uint64_t max_domain_voxels = std::uint64_t{1} << 36;
   ProgressHook progress;
 };
 
 struct CptTimings {
-  double orient = 0, bin = 0, distance = 0, propagate = 0, sign = 0, membrane = 0, assemble = 0, total = 0;
+  double orient = 0, bin = 0, distance = 0, sign = 0, membrane = 0, assemble = 0, total = 0;
 };
 
 struct CptResult {
   NarrowBand band;
   std::vector<Vec3f> closest_points;  // per active voxel, in band value order (if requested)
   std::uint64_t triangles = 0;
-  double exact_shell = 0;                   // voxels, as used (options.exact_shell or chosen)
-  std::uint64_t brick_triangle_pairs = 0;   // within the exact shell
-  std::uint64_t propagation_layers = 0;     // distance buckets beyond the shell
-  std::uint64_t propagation_evaluations = 0;  // point-triangle distances they evaluated
-  std::uint64_t propagation_corrected = 0;    // propagated voxels the exact pass corrected
+  CptMethod method = CptMethod::slab_scan;  // as used (options.method or chosen)
+  std::uint64_t brick_triangle_pairs = 0;   // triangles listed per brick (within W*h or 1 voxel)
+  std::uint64_t polyhedra = 0;              // characteristic polyhedra scanned
+  std::uint64_t evaluations = 0;            // ... and their point-triangle distances
   std::uint64_t faces_flipped = 0;  // by the orientation pass
   std::uint64_t winding_queries = 0;
   std::uint64_t open_edges = 0;                 // of the oriented sign mesh (0: closed)

@@ -33,8 +33,7 @@ struct CptArgs {
   double voxel_size = 0.0;  // > 0 overrides resolution
   double band = 3.0;
   bool closest_points = false;
-  double exact_shell = -1.0;  // voxels scanned exactly, propagation beyond; < 0: chosen (CptOptions)
-  bool approximate = false;  // skip the exact pass after the propagation
+  std::string method = "auto";  // auto, characteristic or slab (CptMethod)
   std::string output;
   std::string stats;
 };

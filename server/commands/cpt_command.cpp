@@ -28,8 +28,9 @@ int run_cpt(const CptArgs& args) {
     options.frame = frame_for_resolution(read.mesh.bounds(), args.resolution, args.band);
   }
   options.closest_points = args.closest_points;
-  options.exact_shell = args.exact_shell;
-  options.exact = !args.approximate;
+  options.method = args.method == "slab"             ? CptMethod::slab_scan
+                   : args.method == "characteristic" ? CptMethod::characteristic
+                                                     : CptMethod::automatic;
   const CptResult cpt = closest_point_transform(read.mesh, options);
   const auto t2 = std::chrono::steady_clock::now();
   LsgWriteOptions write_options;
@@ -53,7 +54,6 @@ int run_cpt(const CptArgs& args) {
   stats.seconds["orient"] = cpt.seconds.orient;
   stats.seconds["bin"] = cpt.seconds.bin;
   stats.seconds["distance"] = cpt.seconds.distance;
-  stats.seconds["propagate"] = cpt.seconds.propagate;
   stats.seconds["sign"] = cpt.seconds.sign;
   stats.seconds["membrane"] = cpt.seconds.membrane;
   stats.seconds["assemble"] = cpt.seconds.assemble;
@@ -65,11 +65,9 @@ int run_cpt(const CptArgs& args) {
   stats.extra["bricks"] = cpt.band.brick_count();
   stats.extra["voxel_size"] = cpt.band.voxel_size();
   stats.extra["brick_triangle_pairs"] = cpt.brick_triangle_pairs;
-  stats.extra["exact_shell"] = cpt.exact_shell;
-  stats.extra["exact"] = !args.approximate;
-  stats.extra["propagation_layers"] = cpt.propagation_layers;
-  stats.extra["propagation_evaluations"] = cpt.propagation_evaluations;
-  stats.extra["propagation_corrected"] = cpt.propagation_corrected;
+  stats.extra["method"] = cpt.method == CptMethod::slab_scan ? "slab" : "characteristic";
+  stats.extra["polyhedra"] = cpt.polyhedra;
+  stats.extra["distance_evaluations"] = cpt.evaluations;
   stats.extra["faces_flipped"] = cpt.faces_flipped;
   stats.extra["winding_queries"] = cpt.winding_queries;
   stats.extra["open_edges"] = cpt.open_edges;

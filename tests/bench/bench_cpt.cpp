@@ -2,8 +2,9 @@
 // voxel size and band half-width W, at 2 threads (and 1 for the coarse W = 3 rows). Prints
 // both times, the ratio ours / OpenVDB per row (target <= 0.5x, issue 20) and both active
 // voxel counts, then one summary line per kind (coarse, dense): the worst ratio.
-// Columns: ours (exact, the default: scan or propagation with its exact pass, "method"), ours
-//   without the exact pass (--approximate, OpenVDB's kind of answer), OpenVDB, both ratios.
+// Columns: ours (the default: the characteristic scan, or the slab scan where it is estimated
+//   cheaper: "method"), OpenVDB, the slab scan alone on the coarse rows and the sphere (0 where
+//   not run), the ratio ours / OpenVDB.
 // Rows: coarse CGAL meshes (knot, bunny) at R = 256 and 512, W = 3, 6, 12; dense meshes, where
 //   there is about one triangle per surface voxel as in scans and meshes extracted from grids:
 //   a marching-cubes sphere at R = 256 (588k triangles) and every CGAL mesh subdivided until
@@ -43,6 +44,7 @@ struct Row {
   int threads;
   int runs;
   const char* kind;
+  bool slab = false;  // also time the slab scan
 };
 
 bool bench_row(const Row& row, bench::RatioSummary& summary) {
@@ -50,17 +52,20 @@ bool bench_row(const Row& row, bench::RatioSummary& summary) {
   CptOptions options;
   options.frame = frame_for_resolution(row.mesh->bounds(), row.resolution, row.half_width);
   std::uint64_t ours_active = 0, vdb_active = 0;
-  double shell = 0;
+  CptMethod method = CptMethod::automatic;
   const double ours = bench::best_of(row.runs, [&] {
     const CptResult r = closest_point_transform(*row.mesh, options);
     ours_active = r.band.active_voxel_count();
-    shell = r.exact_shell;
+    method = r.method;
   });
-  // Propagation without its exact pass (--approximate): OpenVDB's kind of answer.
-  CptOptions approximate = options;
-  approximate.exact_shell = 1.0;
-  approximate.exact = false;
-  const double approx = row.threads == 2 ? bench::best_of(row.runs, [&] { closest_point_transform(*row.mesh, approximate); }) : 0.0;
+  // The slab scan on the same row (the method before the characteristic scan), where it takes
+  // less than a minute: its W^3 work per triangle is what the characteristic scan removes.
+  double slab = 0;
+  if (row.slab) {
+    CptOptions by_slab = options;
+    by_slab.method = CptMethod::slab_scan;
+    slab = bench::best_of(row.runs, [&] { closest_point_transform(*row.mesh, by_slab); });
+  }
   auto xf = openvdb::math::Transform::createLinearTransform(options.frame.voxel_size);
   const double vdb = bench::best_of(row.runs, [&] {
     vdb_active = openvdb::tools::meshToLevelSet<openvdb::FloatGrid>(*xf, row.vdb->points, row.vdb->triangles,
@@ -70,14 +75,13 @@ bool bench_row(const Row& row, bench::RatioSummary& summary) {
   char label[160];
   std::snprintf(label, sizeof label, "%s R=%d W=%g thr=%d", row.name.c_str(), row.resolution, row.half_width,
                 row.threads);
-  std::printf("%-24s %8zu %5d %4g %3d %6s %9.3f %9.3f %9.3f %7.3fx %7.3fx %10llu %10llu\n", row.name.c_str(),
+  std::printf("%-24s %8zu %5d %4g %3d %6s %9.3f %9.3f %9.3f %7.3fx %10llu %10llu\n", row.name.c_str(),
               row.mesh->triangles.size(), row.resolution, row.half_width, row.threads,
-              shell < row.half_width ? "prop" : "scan", ours, approx, vdb, ours / vdb, approx / vdb,
+              method == CptMethod::slab_scan ? "slab" : "charac", ours, vdb, slab, ours / vdb,
               (unsigned long long)ours_active, (unsigned long long)vdb_active);
   std::fflush(stdout);
   if (row.threads == 2) {
     summary.add(row.kind, 0.5, label, ours / vdb);
-    summary.add(std::string(row.kind) + " approximate", 0.5, label, approx / vdb);
   }
   const double diff = std::abs(double(ours_active) - double(vdb_active)) / double(vdb_active);
   return diff < 0.05;
@@ -92,14 +96,14 @@ TriangleMesh marching_cubes_sphere(int resolution) {
   return marching_cubes(band).mesh;
 }
 
-bool bench_dense(const std::string& name, const TriangleMesh& coarse, int resolution,
+bool bench_dense(const std::string& name, const TriangleMesh& coarse, int resolution, bool slab,
                  bench::RatioSummary& summary) {
   const TriangleMesh mesh =
       test::densify(coarse, frame_for_resolution(coarse.bounds(), resolution, 3.0).voxel_size);
   const bench::VdbMesh vdb = bench::vdb_mesh(mesh);
   bool ok = true;
   for (double w : {3.0, 6.0, 12.0})
-    ok &= bench_row({name, &mesh, &vdb, resolution, w, 2, 1, "dense"}, summary);
+    ok &= bench_row({name, &mesh, &vdb, resolution, w, 2, 1, "dense", slab}, summary);
   return ok;
 }
 
@@ -113,8 +117,8 @@ int main(int argc, char** argv) {
   const std::string data = std::string(LEVELSET_CGAL_DATA) + "/meshes/";
   std::printf("bench_cpt: closest point transform vs OpenVDB %s meshToLevelSet\n",
               openvdb::getLibraryAbiVersionString());
-  std::printf("%-24s %8s %5s %4s %3s %6s %9s %9s %9s %8s %8s %10s %10s\n", "mesh", "tris", "R", "W", "thr", "method",
-              "ours_s", "approx_s", "vdb_s", "ratio", "approx", "our_active", "vdb_active");
+  std::printf("%-24s %8s %5s %4s %3s %6s %9s %9s %9s %8s %10s %10s\n", "mesh", "tris", "R", "W", "thr", "method",
+              "ours_s", "vdb_s", "slab_s", "ratio", "our_active", "vdb_active");
   bench::RatioSummary summary("bench_cpt");
   return bench::run_bench("bench_cpt", nullptr, [&] {
     bool ok = true;
@@ -136,10 +140,10 @@ int main(int argc, char** argv) {
         const TriangleMesh mesh = read_mesh(path).mesh;
         const bench::VdbMesh vdb = bench::vdb_mesh(mesh);
         for (int res : {256, 512})
-          for (int threads : {1, 2}) ok &= bench_row({name, &mesh, &vdb, res, 3.0, threads, 3, "coarse"}, summary);
-        for (double w : {6.0, 12.0}) ok &= bench_row({name, &mesh, &vdb, 256, w, 2, 3, "coarse"}, summary);
+          for (int threads : {1, 2}) ok &= bench_row({name, &mesh, &vdb, res, 3.0, threads, 3, "coarse", true}, summary);
+        for (double w : {6.0, 12.0}) ok &= bench_row({name, &mesh, &vdb, 256, w, 2, 3, "coarse", true}, summary);
       }
-    ok &= bench_dense("sphere (marching cubes)", marching_cubes_sphere(256), 256, summary);
+    ok &= bench_dense("sphere (marching cubes)", marching_cubes_sphere(256), 256, true, summary);
     std::vector<std::filesystem::path> files;
     for (const auto& entry : std::filesystem::directory_iterator(data)) files.push_back(entry.path());
     std::sort(files.begin(), files.end());
@@ -151,7 +155,7 @@ int main(int argc, char** argv) {
         continue;  // not a mesh our readers take
       }
       if (mesh.triangles.empty()) continue;
-      ok &= bench_dense(path.filename().string(), mesh, 128, summary);
+      ok &= bench_dense(path.filename().string(), mesh, 128, false, summary);
     }
     summary.print();
     return ok;

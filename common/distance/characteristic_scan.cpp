@@ -1,0 +1,404 @@
+#include "distance/characteristic_scan.hpp"
+
+#include <algorithm>
+#include <atomic>
+#include <bit>
+#include <cmath>
+#include <limits>
+
+#include <tbb/parallel_for.h>
+#include <tbb/parallel_sort.h>
+
+#include "distance/brick_set.hpp"
+#include "distance/open_edges.hpp"
+#include "geometry/point_triangle.hpp"
+
+namespace levelset {
+
+namespace {
+
+// Welded adjacency: per triangle edge the one other triangle across it (manifold edges only),
+// per welded vertex its lowest-index triangle and its neighbouring vertex positions.
+struct Adjacency {
+  std::vector<std::uint32_t> welded;          // per input vertex
+  std::vector<std::uint32_t> across;          // 3 per triangle: edge k = (v_k, v_k+1)
+  std::vector<std::uint32_t> first_triangle;  // per welded id (kNoTriangle: unused)
+  std::vector<std::uint32_t> ring_offsets;    // per welded id, CSR into ring_vertices
+  std::vector<std::uint32_t> ring_vertices;   // input vertex indices of distinct neighbours
+};
+
+Adjacency build_adjacency(const TriangleMesh& mesh) {
+  Adjacency adj;
+  adj.welded = weld_exact(mesh.vertices);
+  const std::size_t nt = mesh.triangles.size(), nv = mesh.vertices.size();
+  struct EdgeUse {
+    std::uint32_t lo, hi, tri, k;
+  };
+  std::vector<EdgeUse> uses(3 * nt);
+  for (std::size_t t = 0; t < nt; ++t)
+    for (std::uint32_t k = 0; k < 3; ++k) {
+      const std::uint32_t a = adj.welded[mesh.triangles[t][k]], b = adj.welded[mesh.triangles[t][(k + 1) % 3]];
+      uses[3 * t + k] = {std::min(a, b), std::max(a, b), std::uint32_t(t), k};
+    }
+  tbb::parallel_sort(uses.begin(), uses.end(), [](const EdgeUse& x, const EdgeUse& y) {
+    if (x.lo != y.lo) return x.lo < y.lo;
+    if (x.hi != y.hi) return x.hi < y.hi;
+    return x.tri < y.tri || (x.tri == y.tri && x.k < y.k);
+  });
+  adj.across.assign(3 * nt, kNoTriangle);
+  adj.first_triangle.assign(nv, kNoTriangle);
+  std::vector<std::vector<std::uint32_t>> ring(nv);
+  for (std::size_t i = 0; i < uses.size();) {
+    std::size_t j = i;
+    while (j < uses.size() && uses[j].lo == uses[i].lo && uses[j].hi == uses[i].hi) ++j;
+    if (j - i == 2 && uses[i].lo != uses[i].hi) {
+      adj.across[3 * uses[i].tri + uses[i].k] = uses[i + 1].tri;
+      adj.across[3 * uses[i + 1].tri + uses[i + 1].k] = uses[i].tri;
+    }
+    if (uses[i].lo != uses[i].hi) {
+      ring[uses[i].lo].push_back(uses[i].hi);
+      ring[uses[i].hi].push_back(uses[i].lo);
+    }
+    i = j;
+  }
+  for (std::size_t t = 0; t < nt; ++t)
+    for (int k = 0; k < 3; ++k) {
+      std::uint32_t& first = adj.first_triangle[adj.welded[mesh.triangles[t][k]]];
+      first = std::min(first, std::uint32_t(t));
+    }
+  adj.ring_offsets.assign(nv + 1, 0);
+  for (std::size_t v = 0; v < nv; ++v) adj.ring_offsets[v + 1] = adj.ring_offsets[v] + std::uint32_t(ring[v].size());
+  adj.ring_vertices.reserve(adj.ring_offsets[nv]);
+  for (std::size_t v = 0; v < nv; ++v) adj.ring_vertices.insert(adj.ring_vertices.end(), ring[v].begin(), ring[v].end());
+  return adj;
+}
+
+// A convex polyhedron: half-spaces g . x <= c and a world box containing it.
+struct Polyhedron {
+  Vec3d g[24];
+  double c[24];
+  int planes = 0;
+  Vec3d lo, hi;
+
+  void add(const Vec3d& normal, double offset) {
+    if (planes < 24) {
+      g[planes] = normal;
+      c[planes] = offset;
+      ++planes;
+    }
+  }
+  // g . x <= g . point + slack
+  void add_through(const Vec3d& normal, const Vec3d& point, double slack) { add(normal, dot(normal, point) + slack); }
+  void box_of(const Vec3d* points, int n) {
+    lo = hi = points[0];
+    for (int i = 1; i < n; ++i) {
+      lo = min(lo, points[i]);
+      hi = max(hi, points[i]);
+    }
+  }
+};
+
+Vec3d unit(const Vec3d& v) {
+  const double l = length(v);
+  return l > 0 ? v / l : Vec3d{0, 0, 0};
+}
+
+// Per voxel: (float bits of the distance << 32) | triangle, minimised atomically. Non-negative
+// floats order like their bits, so the minimum is the nearest triangle, ties to the lowest.
+class MinField {
+ public:
+  MinField(const BrickSet& set, const GridFrame& frame)
+      : set_(set), frame_(frame), cells_(set.bricks.size() * std::size_t(kBrickVoxels)) {
+    for (auto& c : cells_) c.store(kEmpty, std::memory_order_relaxed);
+  }
+  static constexpr std::uint64_t kEmpty = ~std::uint64_t{0};
+
+  std::uint64_t* raw() { return reinterpret_cast<std::uint64_t*>(cells_.data()); }
+  const BrickSet& set() const { return set_; }
+  std::size_t size() const { return cells_.size(); }
+  std::uint64_t load(std::size_t i) const { return cells_[i].load(std::memory_order_relaxed); }
+  void offer(std::size_t cell, float distance, std::uint32_t tri) {
+    const std::uint64_t value = (std::uint64_t(std::bit_cast<std::uint32_t>(distance)) << 32) | tri;
+    std::uint64_t old = cells_[cell].load(std::memory_order_relaxed);
+    while (value < old && !cells_[cell].compare_exchange_weak(old, value, std::memory_order_relaxed)) {
+    }
+  }
+
+ private:
+  const BrickSet& set_;
+  const GridFrame& frame_;
+  std::vector<std::atomic<std::uint64_t>> cells_;
+};
+
+class Scanner {
+ public:
+  Scanner(const TriangleMesh& mesh, MinField& field, const GridFrame& frame)
+      : mesh_(mesh), field_(field), frame_(frame) {
+    h_ = frame.voxel_size;
+    r_ = frame.half_width * h_;
+    band2_ = r_ * r_;
+    slack_ = 1e-7 * h_;
+  }
+  std::uint64_t evaluations = 0, polyhedra = 0;
+
+  // Scan-converts p: voxels inside get their distance to triangle tri.
+  void scan(const Polyhedron& p, std::uint32_t tri) {
+    ++polyhedra;
+    int lo[3], hi[3];
+    for (int a = 0; a < 3; ++a) {
+      lo[a] = int(std::ceil((p.lo[a] - frame_.origin[a]) / h_ - 1e-9));
+      hi[a] = int(std::floor((p.hi[a] - frame_.origin[a]) / h_ + 1e-9));
+      if (lo[a] > hi[a]) return;
+    }
+    // Columns along the box's longest axis: fewest columns.
+    int k = 0;
+    for (int a = 1; a < 3; ++a)
+      if (hi[a] - lo[a] > hi[k] - lo[k]) k = a;
+    const int u = (k + 1) % 3, v = (k + 2) % 3;
+    const auto& f = mesh_.triangles[tri];
+    const Vec3d &ta = mesh_.vertices[f[0]], &tb = mesh_.vertices[f[1]], &tc = mesh_.vertices[f[2]];
+    for (int jv = lo[v]; jv <= hi[v]; ++jv) {
+      const double xv = frame_.origin[v] + jv * h_;
+      for (int ju = lo[u]; ju <= hi[u]; ++ju) {
+        const double xu = frame_.origin[u] + ju * h_;
+        double t0 = frame_.origin[k] + lo[k] * h_, t1 = frame_.origin[k] + hi[k] * h_;
+        for (int i = 0; i < p.planes && t0 <= t1; ++i) {
+          const double s = p.g[i][k], rhs = p.c[i] - p.g[i][u] * xu - p.g[i][v] * xv;
+          if (s > 1e-300) t1 = std::min(t1, rhs / s);
+          else if (s < -1e-300) t0 = std::max(t0, rhs / s);
+          else if (rhs < 0) t1 = t0 - 1;  // parallel and outside
+        }
+        if (t0 > t1) continue;
+        const int k0 = std::max(lo[k], int(std::ceil((t0 - frame_.origin[k]) / h_ - 1e-9)));
+        const int k1 = std::min(hi[k], int(std::floor((t1 - frame_.origin[k]) / h_ + 1e-9)));
+        Coord c;
+        c[u] = ju;
+        c[v] = jv;
+        Vec3d x;
+        x[u] = xu;
+        x[v] = xv;
+        for (int kk = k0; kk <= k1; ++kk) {
+          c[k] = kk;
+          x[k] = frame_.origin[k] + kk * h_;
+          const double d2 = closest_point_on_triangle(x, ta, tb, tc).distance_squared;
+          ++evaluations;
+          if (!(d2 <= band2_)) continue;
+          const std::size_t cell = cell_of(c);
+          if (cell != kNoCell) field_.offer(cell, static_cast<float>(std::sqrt(d2)), tri);
+        }
+      }
+    }
+  }
+
+ private:
+  static constexpr std::size_t kNoCell = ~std::size_t{0};
+  std::size_t cell_of(const Coord& voxel) {
+    const Coord b = brick_of(voxel);
+    if (!(b == cached_brick_) || !cached_valid_) {
+      cached_brick_ = b;
+      cached_valid_ = true;
+      cached_slot_ = field_.set().slot_of(b);
+    }
+    if (cached_slot_ == kNoBrick) return kNoCell;
+    return std::size_t(cached_slot_) * kBrickVoxels + std::size_t(local_index(voxel));
+  }
+  const TriangleMesh& mesh_;
+  MinField& field_;
+  const GridFrame& frame_;
+  double h_ = 0, r_ = 0, band2_ = 0, slack_ = 0;
+  Coord cached_brick_;
+  bool cached_valid_ = false;
+  std::uint32_t cached_slot_ = kNoBrick;
+
+ public:
+  double slack() const { return slack_; }
+  double radius() const { return r_; }
+};
+
+// The box of p0 + R d over a 2D cone of unit directions (between d1 and d2 through mid, angle
+// theta) and both edge ends, or the whole cylinder's box when the cone is wide.
+void wedge_box(Polyhedron& p, const Vec3d& p0, const Vec3d& p1, const Vec3d& d1, const Vec3d& d2, const Vec3d& mid,
+               double theta, double r) {
+  if (theta > 2.1) {  // wider than ~120 degrees: the cylinder's box
+    const Vec3d e{r, r, r};
+    p.lo = min(p0, p1) - e;
+    p.hi = max(p0, p1) + e;
+    return;
+  }
+  const double bulge = r / std::max(0.5, std::cos(0.5 * theta));
+  const Vec3d pts[8] = {p0, p1, p0 + d1 * r, p0 + d2 * r, p1 + d1 * r, p1 + d2 * r, p0 + mid * bulge, p1 + mid * bulge};
+  p.box_of(pts, 8);
+}
+
+void scan_triangle_features(const TriangleMesh& mesh, const Adjacency& adj, std::uint32_t t, Scanner& scanner) {
+  const auto& f = mesh.triangles[t];
+  const Vec3d v[3] = {mesh.vertices[f[0]], mesh.vertices[f[1]], mesh.vertices[f[2]]};
+  const double r = scanner.radius(), eps = scanner.slack();
+  const Vec3d big = cross(v[1] - v[0], v[2] - v[0]);
+  const double area2 = length(big);
+  const double scale = std::max({length(v[1] - v[0]), length(v[2] - v[1]), length(v[0] - v[2])});
+  const bool flat = area2 > 1e-12 * scale * scale;  // has a plane (not degenerate)
+  const Vec3d n = flat ? big / area2 : Vec3d{0, 0, 0};
+  Vec3d m[3];  // outward in-plane normals of the edges
+  for (int k = 0; k < 3; ++k) m[k] = flat ? unit(cross(v[(k + 1) % 3] - v[k], n)) : Vec3d{0, 0, 0};
+  // Face prism.
+  if (flat) {
+    Polyhedron p;
+    for (int k = 0; k < 3; ++k) p.add_through(m[k], v[k], eps);
+    p.add_through(n, v[0], r + eps);
+    p.add_through(n * -1.0, v[0], r + eps);
+    const Vec3d off = n * (r + eps);
+    const Vec3d pts[6] = {v[0] + off, v[1] + off, v[2] + off, v[0] - off, v[1] - off, v[2] - off};
+    p.box_of(pts, 6);
+    scanner.scan(p, t);
+  }
+  // Edge wedges.
+  for (int k = 0; k < 3; ++k) {
+    const Vec3d &p0 = v[k], &p1 = v[(k + 1) % 3];
+    const Vec3d axis = unit(p1 - p0);
+    if (length(p1 - p0) == 0.0) continue;  // a point: its vertices' cones cover it
+    Polyhedron p;
+    p.add_through(axis * -1.0, p0, eps);
+    p.add_through(axis, p1, eps);
+    const std::uint32_t other = adj.across[3 * std::size_t(t) + std::size_t(k)];
+    Vec3d m2{0, 0, 0};
+    bool two = false;
+    if (flat) p.add_through(m[k] * -1.0, p0, eps);
+    if (flat && other != kNoTriangle) {
+      const auto& g = mesh.triangles[other];
+      const Vec3d w[3] = {mesh.vertices[g[0]], mesh.vertices[g[1]], mesh.vertices[g[2]]};
+      const Vec3d nb = cross(w[1] - w[0], w[2] - w[0]);
+      const double nl = length(nb);
+      if (nl > 1e-12 * scale * scale) {
+        // The other face's outward normal at this edge: in its plane, perpendicular to the
+        // edge, pointing away from its third vertex.
+        Vec3d q = unit(cross(axis, nb / nl));
+        int third = 0;
+        while (third < 3 && (adj.welded[g[third]] == adj.welded[f[k]] || adj.welded[g[third]] == adj.welded[f[(k + 1) % 3]]))
+          ++third;
+        if (third < 3 && dot(w[third] - p0, q) > 0) q = q * -1.0;
+        m2 = q;
+        two = true;
+        p.add_through(m2 * -1.0, p0, eps);
+      }
+    }
+    if (flat && two) {
+      // The wedge's cross-section: directions u (perpendicular to the edge) with u.m >= 0 and
+      // u.m2 >= 0; its sides are perpendicular to m and to m2.
+      Vec3d d1 = unit(cross(axis, m[k])), d2 = unit(cross(axis, m2));
+      if (dot(d1, m2) < 0) d1 = d1 * -1.0;
+      if (dot(d2, m[k]) < 0) d2 = d2 * -1.0;
+      const Vec3d sum = m[k] + m2;
+      const double theta = std::acos(std::clamp(dot(d1, d2), -1.0, 1.0));
+      if (length(sum) < 1e-9) {  // coplanar: the wedge is the plane through the edge along n
+        const Vec3d pts[4] = {p0 + n * r, p0 - n * r, p1 + n * r, p1 - n * r};
+        p.box_of(pts, 4);
+      } else {
+        wedge_box(p, p0, p1, d1, d2, unit(sum), theta, r + eps);
+      }
+    } else if (flat) {
+      // One face only (a border or a non-manifold edge): the half cylinder beyond it.
+      const Vec3d e{r + eps, r + eps, r + eps};
+      p.lo = min(p0, p1) - e;
+      p.hi = max(p0, p1) + e;
+    } else {
+      const Vec3d e{r + eps, r + eps, r + eps};
+      p.lo = min(p0, p1) - e;
+      p.hi = max(p0, p1) + e;
+    }
+    scanner.scan(p, t);
+  }
+  // Vertex cones, once per welded vertex (by its lowest-index triangle).
+  for (int k = 0; k < 3; ++k) {
+    const std::uint32_t w = adj.welded[f[k]];
+    if (adj.first_triangle[w] != t) continue;
+    if (k > 0 && adj.welded[f[0]] == w) continue;
+    if (k > 1 && adj.welded[f[1]] == w) continue;
+    Polyhedron p;
+    Vec3d dirs[64];
+    int nd = 0;
+    for (std::uint32_t i = adj.ring_offsets[w]; i < adj.ring_offsets[w + 1]; ++i) {
+      const Vec3d d = unit(mesh.vertices[adj.ring_vertices[i]] - v[k]);
+      if (nd < 64) dirs[nd++] = d;
+      p.add_through(d, v[k], eps);
+    }
+    const bool capped = adj.ring_offsets[w + 1] - adj.ring_offsets[w] > 24 || nd < 3;
+    // Extreme rays of {x : x . d_i <= 0}: cross products of pairs that satisfy every
+    // constraint; the box of v + R' rays (R' covers the cap between them), or the ball's box.
+    Vec3d rays[64];
+    int nr = 0;
+    bool overflow = false;
+    for (int i = 0; i < nd && !capped; ++i)
+      for (int j = i + 1; j < nd; ++j) {
+        Vec3d c = unit(cross(dirs[i], dirs[j]));
+        if (length(c) == 0.0) continue;
+        for (int s = 0; s < 2; ++s, c = c * -1.0) {
+          bool ok = true;
+          for (int l = 0; l < nd && ok; ++l) ok = dot(c, dirs[l]) <= 1e-9;
+          if (!ok) continue;
+          bool known = false;
+          for (int q = 0; q < nr && !known; ++q) known = dot(rays[q], c) > 1.0 - 1e-12;
+          if (known) continue;
+          if (nr == 64) overflow = true;
+          else rays[nr++] = c;
+        }
+      }
+    double spread = 0;
+    for (int i = 0; i < nr; ++i)
+      for (int j = i + 1; j < nr; ++j) spread = std::max(spread, std::acos(std::clamp(dot(rays[i], rays[j]), -1.0, 1.0)));
+    if (capped || overflow || nr < 2 || spread > 2.0) {
+      const Vec3d e{r + eps, r + eps, r + eps};
+      p.lo = v[k] - e;
+      p.hi = v[k] + e;
+    } else {
+      const double reach = 1.5 * (r + eps) / std::cos(0.5 * spread);
+      Vec3d pts[65];
+      pts[0] = v[k];
+      for (int i = 0; i < nr; ++i) pts[i + 1] = v[k] + rays[i] * reach;
+      p.box_of(pts, nr + 1);
+      const Vec3d e{r + eps, r + eps, r + eps};
+      p.lo = max(p.lo, v[k] - e);
+      p.hi = min(p.hi, v[k] + e);
+    }
+    scanner.scan(p, t);
+  }
+}
+
+}  // namespace
+
+CharacteristicScanResult characteristic_scan(const TriangleMesh& mesh, const std::vector<Coord>& shell_bricks,
+                                             const CharacteristicScanOptions& options) {
+  CharacteristicScanResult result;
+  const int reach = int(std::ceil((options.frame.half_width + 1.0) / kBrickDim));
+  const BrickSet set = dilate_bricks(shell_bricks, reach);
+  MinField field(set, options.frame);
+  const Adjacency adj = build_adjacency(mesh);
+  std::atomic<std::uint64_t> evaluations{0}, polyhedra{0};
+  const std::size_t nt = mesh.triangles.size(), batch = 1 << 16;
+  for (std::size_t start = 0; start < nt; start += batch) {
+    const std::size_t end = std::min(nt, start + batch);
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(start, end, 64), [&](const tbb::blocked_range<std::size_t>& range) {
+      Scanner scanner(mesh, field, options.frame);
+      for (std::size_t t = range.begin(); t != range.end(); ++t)
+        scan_triangle_features(mesh, adj, std::uint32_t(t), scanner);
+      evaluations += scanner.evaluations;
+      polyhedra += scanner.polyhedra;
+    });
+    options.progress.step(double(end) / double(nt), "characteristic scan");
+  }
+  result.evaluations = evaluations.load();
+  result.polyhedra = polyhedra.load();
+  ClosestTriangleField& out = result.field;
+  out.bricks = set.bricks;
+  out.distance.assign(field.size(), std::numeric_limits<float>::infinity());
+  out.owner.assign(field.size(), kNoTriangle);
+  tbb::parallel_for(std::size_t(0), field.size(), [&](std::size_t i) {
+    const std::uint64_t value = field.load(i);
+    if (value == MinField::kEmpty) return;
+    out.distance[i] = std::bit_cast<float>(std::uint32_t(value >> 32));
+    out.owner[i] = std::uint32_t(value);
+  });
+  return result;
+}
+
+}  // namespace levelset
