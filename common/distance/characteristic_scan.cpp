@@ -107,13 +107,11 @@ Vec3d unit(const Vec3d& v) {
 // floats order like their bits, so the minimum is the nearest triangle, ties to the lowest.
 class MinField {
  public:
-  MinField(const BrickSet& set, const GridFrame& frame)
-      : set_(set), frame_(frame), cells_(set.bricks.size() * std::size_t(kBrickVoxels)) {
+  explicit MinField(const BrickSet& set) : set_(set), cells_(set.bricks.size() * std::size_t(kBrickVoxels)) {
     for (auto& c : cells_) c.store(kEmpty, std::memory_order_relaxed);
   }
   static constexpr std::uint64_t kEmpty = ~std::uint64_t{0};
 
-  std::uint64_t* raw() { return reinterpret_cast<std::uint64_t*>(cells_.data()); }
   const BrickSet& set() const { return set_; }
   std::size_t size() const { return cells_.size(); }
   std::uint64_t load(std::size_t i) const { return cells_[i].load(std::memory_order_relaxed); }
@@ -126,7 +124,6 @@ class MinField {
 
  private:
   const BrickSet& set_;
-  const GridFrame& frame_;
   std::vector<std::atomic<std::uint64_t>> cells_;
 };
 
@@ -230,138 +227,161 @@ void wedge_box(Polyhedron& p, const Vec3d& p0, const Vec3d& p1, const Vec3d& d1,
   p.box_of(pts, 8);
 }
 
-void scan_triangle_features(const TriangleMesh& mesh, const Adjacency& adj, std::uint32_t t, Scanner& scanner) {
+// One triangle's plane and its edges' outward in-plane normals (none for a degenerate one).
+struct TriangleFrame {
+  Vec3d v[3];
+  Vec3d n;     // unit normal (zero when degenerate)
+  Vec3d m[3];  // edge k = (v_k, v_k+1): outward in-plane unit normal
+  bool flat = false;
+  double scale = 0;  // longest edge
+};
+
+TriangleFrame triangle_frame(const TriangleMesh& mesh, std::uint32_t t) {
   const auto& f = mesh.triangles[t];
-  const Vec3d v[3] = {mesh.vertices[f[0]], mesh.vertices[f[1]], mesh.vertices[f[2]]};
-  const double r = scanner.radius(), eps = scanner.slack();
-  const Vec3d big = cross(v[1] - v[0], v[2] - v[0]);
+  TriangleFrame tf;
+  for (int k = 0; k < 3; ++k) tf.v[k] = mesh.vertices[f[k]];
+  const Vec3d big = cross(tf.v[1] - tf.v[0], tf.v[2] - tf.v[0]);
   const double area2 = length(big);
-  const double scale = std::max({length(v[1] - v[0]), length(v[2] - v[1]), length(v[0] - v[2])});
-  const bool flat = area2 > 1e-12 * scale * scale;  // has a plane (not degenerate)
-  const Vec3d n = flat ? big / area2 : Vec3d{0, 0, 0};
-  Vec3d m[3];  // outward in-plane normals of the edges
-  for (int k = 0; k < 3; ++k) m[k] = flat ? unit(cross(v[(k + 1) % 3] - v[k], n)) : Vec3d{0, 0, 0};
-  // Face prism.
-  if (flat) {
-    Polyhedron p;
-    for (int k = 0; k < 3; ++k) p.add_through(m[k], v[k], eps);
-    p.add_through(n, v[0], r + eps);
-    p.add_through(n * -1.0, v[0], r + eps);
-    const Vec3d off = n * (r + eps);
-    const Vec3d pts[6] = {v[0] + off, v[1] + off, v[2] + off, v[0] - off, v[1] - off, v[2] - off};
-    p.box_of(pts, 6);
-    scanner.scan(p, t);
-  }
-  // Edge wedges.
-  for (int k = 0; k < 3; ++k) {
-    const Vec3d &p0 = v[k], &p1 = v[(k + 1) % 3];
-    const Vec3d axis = unit(p1 - p0);
-    if (length(p1 - p0) == 0.0) continue;  // a point: its vertices' cones cover it
-    Polyhedron p;
-    p.add_through(axis * -1.0, p0, eps);
-    p.add_through(axis, p1, eps);
+  tf.scale = std::max({length(tf.v[1] - tf.v[0]), length(tf.v[2] - tf.v[1]), length(tf.v[0] - tf.v[2])});
+  tf.flat = area2 > 1e-12 * tf.scale * tf.scale;
+  tf.n = tf.flat ? big / area2 : Vec3d{0, 0, 0};
+  for (int k = 0; k < 3; ++k) tf.m[k] = tf.flat ? unit(cross(tf.v[(k + 1) % 3] - tf.v[k], tf.n)) : Vec3d{0, 0, 0};
+  return tf;
+}
+
+// The face's prism: the points that project into it, within W h of its plane.
+void scan_prism(const TriangleFrame& tf, std::uint32_t t, Scanner& scanner) {
+  const double r = scanner.radius(), eps = scanner.slack();
+  Polyhedron p;
+  for (int k = 0; k < 3; ++k) p.add_through(tf.m[k], tf.v[k], eps);
+  p.add_through(tf.n, tf.v[0], r + eps);
+  p.add_through(tf.n * -1.0, tf.v[0], r + eps);
+  const Vec3d off = tf.n * (r + eps);
+  const Vec3d pts[6] = {tf.v[0] + off, tf.v[1] + off, tf.v[2] + off, tf.v[0] - off, tf.v[1] - off, tf.v[2] - off};
+  p.box_of(pts, 6);
+  scanner.scan(p, t);
+}
+
+// The outward in-plane normal of `other` at the edge (p0, axis), or nothing when `other` is
+// degenerate.
+bool other_face_normal(const TriangleMesh& mesh, const Adjacency& adj, std::uint32_t other, const Vec3d& p0,
+                       const Vec3d& axis, std::uint32_t a, std::uint32_t b, double scale, Vec3d& out) {
+  const auto& g = mesh.triangles[other];
+  const Vec3d w[3] = {mesh.vertices[g[0]], mesh.vertices[g[1]], mesh.vertices[g[2]]};
+  const Vec3d nb = cross(w[1] - w[0], w[2] - w[0]);
+  const double nl = length(nb);
+  if (!(nl > 1e-12 * scale * scale)) return false;
+  // In its plane, perpendicular to the edge, pointing away from its third vertex.
+  out = unit(cross(axis, nb / nl));
+  int third = 0;
+  while (third < 3 && (adj.welded[g[third]] == a || adj.welded[g[third]] == b)) ++third;
+  if (third < 3 && dot(w[third] - p0, out) > 0) out = out * -1.0;
+  return true;
+}
+
+// Edge k's wedge: beyond the edge as seen from this face (and from the face across it, when the
+// edge is manifold), between the planes through its ends.
+void scan_wedge(const TriangleMesh& mesh, const Adjacency& adj, const TriangleFrame& tf, std::uint32_t t, int k,
+                Scanner& scanner) {
+  const double r = scanner.radius(), eps = scanner.slack();
+  const Vec3d &p0 = tf.v[k], &p1 = tf.v[(k + 1) % 3];
+  if (length(p1 - p0) == 0.0) return;  // a point: its vertices' cones cover it
+  const Vec3d axis = unit(p1 - p0);
+  Polyhedron p;
+  p.add_through(axis * -1.0, p0, eps);
+  p.add_through(axis, p1, eps);
+  const Vec3d e{r + eps, r + eps, r + eps};
+  p.lo = min(p0, p1) - e;  // the cylinder's box unless the wedge is narrower
+  p.hi = max(p0, p1) + e;
+  if (tf.flat) {
+    p.add_through(tf.m[k] * -1.0, p0, eps);
+    const auto& f = mesh.triangles[t];
     const std::uint32_t other = adj.across[3 * std::size_t(t) + std::size_t(k)];
-    Vec3d m2{0, 0, 0};
-    bool two = false;
-    if (flat) p.add_through(m[k] * -1.0, p0, eps);
-    if (flat && other != kNoTriangle) {
-      const auto& g = mesh.triangles[other];
-      const Vec3d w[3] = {mesh.vertices[g[0]], mesh.vertices[g[1]], mesh.vertices[g[2]]};
-      const Vec3d nb = cross(w[1] - w[0], w[2] - w[0]);
-      const double nl = length(nb);
-      if (nl > 1e-12 * scale * scale) {
-        // The other face's outward normal at this edge: in its plane, perpendicular to the
-        // edge, pointing away from its third vertex.
-        Vec3d q = unit(cross(axis, nb / nl));
-        int third = 0;
-        while (third < 3 && (adj.welded[g[third]] == adj.welded[f[k]] || adj.welded[g[third]] == adj.welded[f[(k + 1) % 3]]))
-          ++third;
-        if (third < 3 && dot(w[third] - p0, q) > 0) q = q * -1.0;
-        m2 = q;
-        two = true;
-        p.add_through(m2 * -1.0, p0, eps);
-      }
-    }
-    if (flat && two) {
-      // The wedge's cross-section: directions u (perpendicular to the edge) with u.m >= 0 and
-      // u.m2 >= 0; its sides are perpendicular to m and to m2.
-      Vec3d d1 = unit(cross(axis, m[k])), d2 = unit(cross(axis, m2));
+    Vec3d m2;
+    if (other != kNoTriangle &&
+        other_face_normal(mesh, adj, other, p0, axis, adj.welded[f[k]], adj.welded[f[(k + 1) % 3]], tf.scale, m2)) {
+      p.add_through(m2 * -1.0, p0, eps);
+      // The cross-section: directions u perpendicular to the edge with u.m >= 0 and u.m2 >= 0;
+      // its sides are perpendicular to m and to m2.
+      Vec3d d1 = unit(cross(axis, tf.m[k])), d2 = unit(cross(axis, m2));
       if (dot(d1, m2) < 0) d1 = d1 * -1.0;
-      if (dot(d2, m[k]) < 0) d2 = d2 * -1.0;
-      const Vec3d sum = m[k] + m2;
-      const double theta = std::acos(std::clamp(dot(d1, d2), -1.0, 1.0));
+      if (dot(d2, tf.m[k]) < 0) d2 = d2 * -1.0;
+      const Vec3d sum = tf.m[k] + m2;
       if (length(sum) < 1e-9) {  // coplanar: the wedge is the plane through the edge along n
-        const Vec3d pts[4] = {p0 + n * r, p0 - n * r, p1 + n * r, p1 - n * r};
+        const Vec3d pts[4] = {p0 + tf.n * r, p0 - tf.n * r, p1 + tf.n * r, p1 - tf.n * r};
         p.box_of(pts, 4);
       } else {
-        wedge_box(p, p0, p1, d1, d2, unit(sum), theta, r + eps);
+        wedge_box(p, p0, p1, d1, d2, unit(sum), std::acos(std::clamp(dot(d1, d2), -1.0, 1.0)), r + eps);
       }
-    } else if (flat) {
-      // One face only (a border or a non-manifold edge): the half cylinder beyond it.
-      const Vec3d e{r + eps, r + eps, r + eps};
-      p.lo = min(p0, p1) - e;
-      p.hi = max(p0, p1) + e;
-    } else {
-      const Vec3d e{r + eps, r + eps, r + eps};
-      p.lo = min(p0, p1) - e;
-      p.hi = max(p0, p1) + e;
     }
-    scanner.scan(p, t);
   }
-  // Vertex cones, once per welded vertex (by its lowest-index triangle).
-  for (int k = 0; k < 3; ++k) {
-    const std::uint32_t w = adj.welded[f[k]];
-    if (adj.first_triangle[w] != t) continue;
-    if (k > 0 && adj.welded[f[0]] == w) continue;
-    if (k > 1 && adj.welded[f[1]] == w) continue;
-    Polyhedron p;
-    Vec3d dirs[64];
-    int nd = 0;
-    for (std::uint32_t i = adj.ring_offsets[w]; i < adj.ring_offsets[w + 1]; ++i) {
-      const Vec3d d = unit(mesh.vertices[adj.ring_vertices[i]] - v[k]);
-      if (nd < 64) dirs[nd++] = d;
-      p.add_through(d, v[k], eps);
-    }
-    const bool capped = adj.ring_offsets[w + 1] - adj.ring_offsets[w] > 24 || nd < 3;
-    // Extreme rays of {x : x . d_i <= 0}: cross products of pairs that satisfy every
-    // constraint; the box of v + R' rays (R' covers the cap between them), or the ball's box.
-    Vec3d rays[64];
-    int nr = 0;
-    bool overflow = false;
-    for (int i = 0; i < nd && !capped; ++i)
-      for (int j = i + 1; j < nd; ++j) {
-        Vec3d c = unit(cross(dirs[i], dirs[j]));
-        if (length(c) == 0.0) continue;
-        for (int s = 0; s < 2; ++s, c = c * -1.0) {
-          bool ok = true;
-          for (int l = 0; l < nd && ok; ++l) ok = dot(c, dirs[l]) <= 1e-9;
-          if (!ok) continue;
-          bool known = false;
-          for (int q = 0; q < nr && !known; ++q) known = dot(rays[q], c) > 1.0 - 1e-12;
-          if (known) continue;
-          if (nr == 64) overflow = true;
-          else rays[nr++] = c;
-        }
+  scanner.scan(p, t);
+}
+
+// Vertex k's cone: the points for which every edge at the vertex points away (the polar cone of
+// its welded edges), scanned once per welded vertex, by its lowest-index triangle.
+void scan_cone(const TriangleMesh& mesh, const Adjacency& adj, const TriangleFrame& tf, std::uint32_t t, int k,
+               Scanner& scanner) {
+  const auto& f = mesh.triangles[t];
+  const std::uint32_t w = adj.welded[f[k]];
+  if (adj.first_triangle[w] != t) return;
+  for (int j = 0; j < k; ++j)
+    if (adj.welded[f[j]] == w) return;  // a repeated vertex of a degenerate face
+  const double r = scanner.radius(), eps = scanner.slack();
+  const Vec3d& v = tf.v[k];
+  Polyhedron p;
+  Vec3d dirs[64];
+  int nd = 0;
+  for (std::uint32_t i = adj.ring_offsets[w]; i < adj.ring_offsets[w + 1]; ++i) {
+    const Vec3d d = unit(mesh.vertices[adj.ring_vertices[i]] - v);
+    if (nd < 64) dirs[nd++] = d;
+    p.add_through(d, v, eps);
+  }
+  const bool capped = adj.ring_offsets[w + 1] - adj.ring_offsets[w] > 24 || nd < 3;
+  // Extreme rays of {x : x . d_i <= 0}: cross products of pairs that satisfy every constraint
+  // (deduplicated); the box of v + R' rays (R' covers the cap between them), else the ball's.
+  Vec3d rays[64];
+  int nr = 0;
+  bool overflow = false;
+  for (int i = 0; i < nd && !capped; ++i)
+    for (int j = i + 1; j < nd; ++j) {
+      Vec3d c = unit(cross(dirs[i], dirs[j]));
+      if (length(c) == 0.0) continue;
+      for (int s = 0; s < 2; ++s, c = c * -1.0) {
+        bool ok = true;
+        for (int l = 0; l < nd && ok; ++l) ok = dot(c, dirs[l]) <= 1e-9;
+        if (!ok) continue;
+        bool known = false;
+        for (int q = 0; q < nr && !known; ++q) known = dot(rays[q], c) > 1.0 - 1e-12;
+        if (known) continue;
+        if (nr == 64) overflow = true;
+        else rays[nr++] = c;
       }
-    double spread = 0;
-    for (int i = 0; i < nr; ++i)
-      for (int j = i + 1; j < nr; ++j) spread = std::max(spread, std::acos(std::clamp(dot(rays[i], rays[j]), -1.0, 1.0)));
-    if (capped || overflow || nr < 2 || spread > 2.0) {
-      const Vec3d e{r + eps, r + eps, r + eps};
-      p.lo = v[k] - e;
-      p.hi = v[k] + e;
-    } else {
-      const double reach = 1.5 * (r + eps) / std::cos(0.5 * spread);
-      Vec3d pts[65];
-      pts[0] = v[k];
-      for (int i = 0; i < nr; ++i) pts[i + 1] = v[k] + rays[i] * reach;
-      p.box_of(pts, nr + 1);
-      const Vec3d e{r + eps, r + eps, r + eps};
-      p.lo = max(p.lo, v[k] - e);
-      p.hi = min(p.hi, v[k] + e);
     }
-    scanner.scan(p, t);
+  double spread = 0;
+  for (int i = 0; i < nr; ++i)
+    for (int j = i + 1; j < nr; ++j) spread = std::max(spread, std::acos(std::clamp(dot(rays[i], rays[j]), -1.0, 1.0)));
+  const Vec3d e{r + eps, r + eps, r + eps};
+  p.lo = v - e;
+  p.hi = v + e;
+  if (!capped && !overflow && nr >= 2 && spread <= 2.0) {
+    const double reach = 1.5 * (r + eps) / std::cos(0.5 * spread);
+    Vec3d pts[65];
+    pts[0] = v;
+    for (int i = 0; i < nr; ++i) pts[i + 1] = v + rays[i] * reach;
+    Polyhedron box;
+    box.box_of(pts, nr + 1);
+    p.lo = max(box.lo, p.lo);
+    p.hi = min(box.hi, p.hi);
   }
+  scanner.scan(p, t);
+}
+
+void scan_triangle_features(const TriangleMesh& mesh, const Adjacency& adj, std::uint32_t t, Scanner& scanner) {
+  const TriangleFrame tf = triangle_frame(mesh, t);
+  if (tf.flat) scan_prism(tf, t, scanner);
+  for (int k = 0; k < 3; ++k) scan_wedge(mesh, adj, tf, t, k, scanner);
+  for (int k = 0; k < 3; ++k) scan_cone(mesh, adj, tf, t, k, scanner);
 }
 
 }  // namespace
@@ -371,7 +391,7 @@ CharacteristicScanResult characteristic_scan(const TriangleMesh& mesh, const std
   CharacteristicScanResult result;
   const int reach = int(std::ceil((options.frame.half_width + 1.0) / kBrickDim));
   const BrickSet set = dilate_bricks(shell_bricks, reach);
-  MinField field(set, options.frame);
+  MinField field(set);
   const Adjacency adj = build_adjacency(mesh);
   std::atomic<std::uint64_t> evaluations{0}, polyhedra{0};
   const std::size_t nt = mesh.triangles.size(), batch = 1 << 16;

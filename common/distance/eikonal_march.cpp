@@ -8,6 +8,7 @@
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_invoke.h>
 
+#include "distance/eikonal_trial_queue.hpp"
 #include "distance/eikonal_update.hpp"
 
 namespace levelset::detail {
@@ -61,76 +62,6 @@ inline float known_update(const RedistanceDomain& w, std::uint32_t b, int n, boo
   }
   return solve_terms(terms[0], terms[1], terms[2]);
 }
-
-struct HeapEntry {
-  float value;
-  std::uint32_t id;  // brick * 512 + voxel
-};
-struct HeapAfter {
-  bool operator()(const HeapEntry& a, const HeapEntry& b) const {
-    return a.value > b.value || (a.value == b.value && a.id > b.id);
-  }
-};
-
-// The trial set: binary min-heaps, one per slice of the value range [0, limit] (a global
-// heap over the whole front misses the cache on every level). The march only ever pops the
-// smallest value, and every pushed value lands in the current slice or a later one, so the
-// pop order is exactly that of one global heap. Values above the limit are never accepted
-// and are not stored.
-class TrialQueue {
- public:
-  explicit TrialQueue(double limit)
-      : limit_(limit),
-        slices_(std::size_t(std::clamp(std::ceil(limit * kSlicesPerVoxel), 1.0, double(kMaxSlices)))),
-        per_unit_(double(slices_.size()) / limit) {}
-
-  void push(const HeapEntry& e) {
-    if (!(double(e.value) <= limit_)) return;
-    std::vector<HeapEntry>& h = slices_[slice_of(e.value)];
-    h.push_back(e);
-    std::push_heap(h.begin(), h.end(), HeapAfter{});
-  }
-  // Bulk insertion of the initial front.
-  void assign(const std::vector<HeapEntry>& entries) {
-    for (const HeapEntry& e : entries)
-      if (double(e.value) <= limit_) slices_[slice_of(e.value)].push_back(e);
-    for (auto& h : slices_) std::make_heap(h.begin(), h.end(), HeapAfter{});
-  }
-  bool pop(HeapEntry& e) {
-    if (!advance()) return false;
-    std::vector<HeapEntry>& h = slices_[current_];
-    std::pop_heap(h.begin(), h.end(), HeapAfter{});
-    e = h.back();
-    h.pop_back();
-    return true;
-  }
-  // The entry pop() would give next (nullptr: none), for prefetching its voxel.
-  const HeapEntry* peek() {
-    if (!advance()) return nullptr;
-    return &slices_[current_].front();
-  }
-
- private:
-  bool advance() {
-    while (current_ < slices_.size() && slices_[current_].empty()) {
-      slices_[current_].shrink_to_fit();
-      ++current_;
-    }
-    return current_ < slices_.size();
-  }
-  static constexpr double kSlicesPerVoxel = 256.0;
-  static constexpr std::size_t kMaxSlices = 1 << 16;
-  std::size_t slice_of(float v) const {
-    const double k = std::floor(double(v) * per_unit_);
-    const std::size_t last = slices_.size() - 1;
-    const std::size_t s = k <= 0.0 ? 0 : (k >= double(last) ? last : std::size_t(k));
-    return std::max(s, current_);  // below the current slice (rounding): still the minimum
-  }
-  double limit_;
-  std::vector<std::vector<HeapEntry>> slices_;
-  double per_unit_;
-  std::size_t current_ = 0;
-};
 
 // Accepts the voxels of one side (inside or not) smallest tentative value first.
 void march_side(RedistanceDomain& w, TrialQueue& trial, bool inside, bool second, const ProgressHook& progress) {

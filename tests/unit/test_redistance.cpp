@@ -13,6 +13,7 @@
 #include "core/error.hpp"
 #include "distance/redistance.hpp"
 #include "grid/band_accessor.hpp"
+#include "distance/eikonal_trial_queue.hpp"
 #include "grid/band_builder.hpp"
 #include "shape_band.hpp"
 
@@ -560,6 +561,53 @@ TEST(RedistanceErrors, CancellationStopsTheWork) {
       EXPECT_EQ(e.code(), ErrorCode::Cancelled);
     }
   }
+}
+
+}  // namespace
+}  // namespace levelset
+
+namespace levelset {
+namespace {
+
+// The march pops a voxel, peeks at the next (to prefetch it), then pushes its neighbours: when
+// that pop emptied the queue, the pushes must still land in a slice that is popped later (they
+// were written past the last slice, a crash in the CPT's membranes of an open dense mesh).
+TEST(TrialQueue, PushAfterAnEmptyPeekIsPopped) {
+  detail::TrialQueue q(12.0);
+  q.push({0.5f, 7});
+  detail::HeapEntry e;
+  ASSERT_TRUE(q.pop(e));
+  EXPECT_EQ(e.id, 7u);
+  EXPECT_EQ(q.peek(), nullptr);
+  q.push({11.9f, 8});
+  q.push({1.5f, 9});
+  q.push({12.5f, 10});  // beyond the limit: never accepted
+  ASSERT_NE(q.peek(), nullptr);
+  ASSERT_TRUE(q.pop(e));
+  EXPECT_EQ(e.id, 9u);
+  ASSERT_TRUE(q.pop(e));
+  EXPECT_EQ(e.id, 8u);
+  EXPECT_FALSE(q.pop(e));
+  EXPECT_EQ(q.peek(), nullptr);
+  q.push({12.0f, 11});  // exactly the limit, after the queue ran dry at its last slice
+  ASSERT_TRUE(q.pop(e));
+  EXPECT_EQ(e.id, 11u);
+}
+
+TEST(TrialQueue, PopsInValueOrderAcrossSlices) {
+  detail::TrialQueue q(6.0);
+  std::vector<float> values;
+  for (int i = 0; i < 2000; ++i) values.push_back(float((i * 7919) % 6000) / 1000.0f);
+  for (std::size_t i = 0; i < values.size(); ++i) q.push({values[i], std::uint32_t(i)});
+  float last = -1;
+  detail::HeapEntry e;
+  std::size_t n = 0;
+  while (q.pop(e)) {
+    EXPECT_GE(e.value, last);
+    last = e.value;
+    ++n;
+  }
+  EXPECT_EQ(n, values.size());
 }
 
 }  // namespace
