@@ -257,6 +257,7 @@ CptResult closest_point_transform(const TriangleMesh& mesh, const CptOptions& op
   // Unsigned distances and closest triangles.
   t = Clock::now();
   ClosestTriangleField field;
+  bool maybe_open = true;  // edges with one face or more than two: the sign may need the margin
   if (slab) {
     field = scan_shell(mesh, lists, options.frame, options.frame.half_width, options.progress);
   } else {
@@ -267,6 +268,7 @@ CptResult closest_point_transform(const TriangleMesh& mesh, const CptOptions& op
     field = std::move(scanned.field);
     result.polyhedra = scanned.polyhedra;
     result.evaluations = scanned.evaluations;
+    maybe_open = scanned.unpaired_edges > 0;
   }
   result.seconds.distance = since(t);
   options.progress.step(0.7, "distance");
@@ -279,14 +281,20 @@ CptResult closest_point_transform(const TriangleMesh& mesh, const CptOptions& op
   InsideMasksOptions sign_options;
   sign_options.frame = options.frame;
   sign_options.progress = options.progress;
-  BrickTriangleLists sign_lists = slab ? std::move(lists) : band_brick_lists(field, lists);
-  InsideMasksResult signs = compute_inside_masks(oriented.mesh, tree, sign_lists, sign_options);
-  if (signs.open_edges > 0 && !slab) {
-    // Near open edges w also varies continuously, and the masks find the bricks that need
-    // direct queries through the triangles listed within the band's margin: bin with it, as
-    // the slab scan does, so open meshes get the same signs (and membranes) either way.
+  // Near open edges w also varies continuously, and the masks find the bricks that need direct
+  // queries through the triangles listed within the band's margin: open meshes get lists with
+  // it, as the slab scan's, so they get the same signs (and membranes) either way. A mesh
+  // whose edges all pair up may still be open for the sign (inconsistent orientation): then
+  // the masks run again with those lists.
+  auto wide_lists = [&] {
     bin.margin = options.frame.half_width * options.frame.voxel_size;
-    sign_lists = bin_triangles_to_bricks(mesh, bin);
+    return bin_triangles_to_bricks(mesh, bin);
+  };
+  BrickTriangleLists sign_lists =
+      slab ? std::move(lists) : (maybe_open ? wide_lists() : band_brick_lists(field, lists));
+  InsideMasksResult signs = compute_inside_masks(oriented.mesh, tree, sign_lists, sign_options);
+  if (signs.open_edges > 0 && !slab && !maybe_open) {
+    sign_lists = wide_lists();
     signs = compute_inside_masks(oriented.mesh, tree, sign_lists, sign_options);
   }
   result.winding_queries = signs.winding_queries;
