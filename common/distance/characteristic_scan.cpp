@@ -25,7 +25,7 @@ struct Adjacency {
   std::vector<std::uint32_t> first_triangle;  // per welded id (kNoTriangle: unused)
   std::vector<std::uint32_t> ring_offsets;    // per welded id, CSR into ring_vertices
   std::vector<std::uint32_t> ring_vertices;   // input vertex indices of distinct neighbours
-  std::uint64_t unpaired_edges = 0;           // edges not shared by exactly two triangles
+  std::uint64_t odd_edges = 0;                // edges used by an odd number of triangles
 };
 
 Adjacency build_adjacency(const TriangleMesh& mesh) {
@@ -55,9 +55,8 @@ Adjacency build_adjacency(const TriangleMesh& mesh) {
     if (j - i == 2 && uses[i].lo != uses[i].hi) {
       adj.across[3 * uses[i].tri + uses[i].k] = uses[i + 1].tri;
       adj.across[3 * uses[i + 1].tri + uses[i + 1].k] = uses[i].tri;
-    } else if (uses[i].lo != uses[i].hi) {
-      ++adj.unpaired_edges;
     }
+    if (uses[i].lo != uses[i].hi && (j - i) % 2 == 1) ++adj.odd_edges;
     if (uses[i].lo != uses[i].hi) {
       ring[uses[i].lo].push_back(uses[i].hi);
       ring[uses[i].hi].push_back(uses[i].lo);
@@ -411,7 +410,7 @@ CharacteristicScanResult characteristic_scan(const TriangleMesh& mesh, const std
   }
   result.evaluations = evaluations.load();
   result.polyhedra = polyhedra.load();
-  result.unpaired_edges = adj.unpaired_edges;
+  result.odd_edges = adj.odd_edges;
   ClosestTriangleField& out = result.field;
   out.bricks = set.bricks;
   out.distance.assign(field.size(), std::numeric_limits<float>::infinity());

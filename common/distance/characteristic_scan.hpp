@@ -52,7 +52,7 @@ struct CharacteristicScanResult {
   ClosestTriangleField field;
   std::uint64_t polyhedra = 0;     // prisms, wedges and cones scanned
   std::uint64_t evaluations = 0;   // point-triangle distances evaluated
-  std::uint64_t unpaired_edges = 0;  // welded edges not shared by exactly two triangles
+  std::uint64_t odd_edges = 0;  // welded edges used by an odd number of triangles (borders)
 };
 
 CharacteristicScanResult characteristic_scan(const TriangleMesh& mesh, const std::vector<Coord>& shell_bricks,

@@ -257,7 +257,7 @@ CptResult closest_point_transform(const TriangleMesh& mesh, const CptOptions& op
   // Unsigned distances and closest triangles.
   t = Clock::now();
   ClosestTriangleField field;
-  bool maybe_open = true;  // edges with one face or more than two: the sign may need the margin
+  bool maybe_open = true;  // edges with an odd number of faces: open, the sign needs the margin
   if (slab) {
     field = scan_shell(mesh, lists, options.frame, options.frame.half_width, options.progress);
   } else {
@@ -268,7 +268,7 @@ CptResult closest_point_transform(const TriangleMesh& mesh, const CptOptions& op
     field = std::move(scanned.field);
     result.polyhedra = scanned.polyhedra;
     result.evaluations = scanned.evaluations;
-    maybe_open = scanned.unpaired_edges > 0;
+    maybe_open = scanned.odd_edges > 0;
   }
   result.seconds.distance = since(t);
   options.progress.step(0.7, "distance");
@@ -284,8 +284,8 @@ CptResult closest_point_transform(const TriangleMesh& mesh, const CptOptions& op
   // Near open edges w also varies continuously, and the masks find the bricks that need direct
   // queries through the triangles listed within the band's margin: open meshes get lists with
   // it, as the slab scan's, so they get the same signs (and membranes) either way. A mesh
-  // whose edges all pair up may still be open for the sign (inconsistent orientation): then
-  // the masks run again with those lists.
+  // whose edges all have an even number of faces may still be open for the sign (inconsistent
+  // orientation): then the masks run again with those lists.
   auto wide_lists = [&] {
     bin.margin = options.frame.half_width * options.frame.voxel_size;
     return bin_triangles_to_bricks(mesh, bin);
