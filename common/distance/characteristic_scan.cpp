@@ -309,15 +309,35 @@ void scan_wedge(const TriangleMesh& mesh, const Adjacency& adj, const TriangleFr
       if (dot(d1, m2) < 0) d1 = d1 * -1.0;
       if (dot(d2, tf.m[k]) < 0) d2 = d2 * -1.0;
       const Vec3d sum = tf.m[k] + m2;
-      if (length(sum) < 1e-9) {  // coplanar: the wedge is the plane through the edge along n
-        const Vec3d pts[4] = {p0 + tf.n * r, p0 - tf.n * r, p1 + tf.n * r, p1 - tf.n * r};
-        p.box_of(pts, 4);
-      } else {
+      // Coplanar faces: the wedge is the plane through the edge along n, whose points project
+      // onto the edge, on both prisms' boundaries (within their slack): nothing to add.
+      if (length(sum) < 1e-9) return;
+      {
         wedge_box(p, p0, p1, d1, d2, unit(sum), std::acos(std::clamp(dot(d1, d2), -1.0, 1.0)), r + eps);
       }
     }
   }
   scanner.scan(p, t);
+}
+
+// All rays on one line (the cone of a flat vertex is the normal line, +-n).
+bool is_line(const Vec3d* rays, int nr) {
+  for (int i = 1; i < nr; ++i)
+    if (std::abs(dot(rays[i], rays[0])) < 1.0 - 1e-9) return false;
+  return true;
+}
+
+// The directions, perpendicular to `axis`, leave no gap of half a turn around it: the vertex is
+// surrounded by its edges in their plane (not a border vertex, whose cone is a half-plane).
+bool surrounds(const Vec3d* dirs, int nd, const Vec3d& axis) {
+  const Vec3d a = unit(std::abs(axis.x) < 0.9 ? cross(axis, Vec3d{1, 0, 0}) : cross(axis, Vec3d{0, 1, 0}));
+  const Vec3d b = cross(axis, a);
+  double angles[64];
+  for (int i = 0; i < nd; ++i) angles[i] = std::atan2(dot(dirs[i], b), dot(dirs[i], a));
+  std::sort(angles, angles + nd);
+  double gap = angles[0] + 2.0 * M_PI - angles[nd - 1];
+  for (int i = 1; i < nd; ++i) gap = std::max(gap, angles[i] - angles[i - 1]);
+  return gap < M_PI - 1e-6;
 }
 
 // Vertex k's cone: the points for which every edge at the vertex points away (the polar cone of
@@ -363,6 +383,9 @@ void scan_cone(const TriangleMesh& mesh, const Adjacency& adj, const TriangleFra
   double spread = 0;
   for (int i = 0; i < nr; ++i)
     for (int j = i + 1; j < nr; ++j) spread = std::max(spread, std::acos(std::clamp(dot(rays[i], rays[j]), -1.0, 1.0)));
+  // A flat vertex surrounded by its edges: its cone is the normal line, whose points project
+  // onto the vertex, on every adjacent prism's boundary (within their slack): nothing to add.
+  if (!capped && !overflow && nr >= 1 && is_line(rays, nr) && surrounds(dirs, nd, rays[0])) return;
   const Vec3d e{r + eps, r + eps, r + eps};
   p.lo = v - e;
   p.hi = v + e;

@@ -151,7 +151,7 @@ TEST(CharacteristicScan, IdenticalForOneAndTwoThreads) {
   ASSERT_EQ(one.closest_points.size(), two.closest_points.size());
   EXPECT_TRUE(std::equal(one.closest_points.begin(), one.closest_points.end(), two.closest_points.begin(),
                          [](const Vec3f& a, const Vec3f& b) { return a.x == b.x && a.y == b.y && a.z == b.z; }));
-  EXPECT_GT(one.polyhedra, 3 * dense.triangles.size());
+  EXPECT_GE(one.polyhedra, dense.triangles.size());  // a prism per face, wedges and cones where not flat
   // About one to two evaluations per band voxel on a smooth dense mesh.
   EXPECT_LT(double(one.evaluations), 3.0 * double(one.band.active_voxel_count()));
 }
