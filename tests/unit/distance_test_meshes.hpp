@@ -5,6 +5,8 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
+#include <cstdlib>
+#include <filesystem>
 #include <limits>
 #include <map>
 #include <numbers>
@@ -41,6 +43,13 @@ inline double brute_force_distance(const TriangleMesh& m, const Vec3d& p) {
     best = std::min(best, closest_point_on_triangle(p, m.vertices[t[0]], m.vertices[t[1]],
                                                     m.vertices[t[2]]).distance_squared);
   return std::sqrt(best);
+}
+
+// CGAL's data/meshes: $LEVELSET_CGAL_DATA when set, else the data install-deps.sh unpacked.
+inline std::filesystem::path cgal_meshes_dir() {
+  const char* env = std::getenv("LEVELSET_CGAL_DATA");
+  return (env != nullptr && *env != '\0' ? std::filesystem::path(env) : std::filesystem::path(LEVELSET_CGAL_DATA)) /
+         "meshes";
 }
 
 inline TriangleMesh load_cgal_mesh(const std::string& name) {

@@ -26,11 +26,6 @@ namespace {
 
 namespace fs = std::filesystem;
 
-fs::path cgal_meshes() {
-  const char* env = std::getenv("LEVELSET_CGAL_DATA");
-  return (env != nullptr && *env != '\0' ? fs::path(env) : fs::path(LEVELSET_CGAL_DATA)) / "meshes";
-}
-
 CptResult run(const TriangleMesh& mesh, const GridFrame& frame, CptMethod method, bool closest = false) {
   CptOptions options;
   options.frame = frame;
@@ -76,7 +71,7 @@ void expect_same(const std::string& what, const Comparison& c) {
 
 std::vector<fs::path> cgal_mesh_files() {
   std::vector<fs::path> files;
-  for (const auto& entry : fs::directory_iterator(cgal_meshes())) files.push_back(entry.path());
+  for (const auto& entry : fs::directory_iterator(test::cgal_meshes_dir())) files.push_back(entry.path());
   std::sort(files.begin(), files.end());
   return files;
 }

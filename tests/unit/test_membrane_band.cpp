@@ -32,11 +32,6 @@ namespace {
 
 namespace fs = std::filesystem;
 
-fs::path cgal_meshes() {
-  const char* env = std::getenv("LEVELSET_CGAL_DATA");
-  return (env != nullptr && *env != '\0' ? fs::path(env) : fs::path(LEVELSET_CGAL_DATA)) / "meshes";
-}
-
 // Open edges of the mesh the CPT signs with (every face once, consistently oriented): the
 // meshes whose winding number is not piecewise constant.
 std::size_t open_edge_count(const TriangleMesh& mesh) {
@@ -82,7 +77,7 @@ std::uint64_t invariant_violations(const NarrowBand& band) {
 }
 
 TEST(MembraneBand, EveryOpenCgalMeshGivesAClosedSurface) {
-  const fs::path dir = cgal_meshes();
+  const fs::path dir = test::cgal_meshes_dir();
   if (!fs::is_directory(dir)) GTEST_SKIP() << "CGAL data meshes not installed: " << dir;
   std::vector<fs::path> files;
   for (const auto& entry : fs::directory_iterator(dir))

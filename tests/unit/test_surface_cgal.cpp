@@ -41,11 +41,6 @@ constexpr int kResolution = 128;
 constexpr double kHalfWidth = 3.0;
 constexpr std::uint64_t kMaxTriangles = 200000;
 
-fs::path cgal_meshes() {
-  const char* env = std::getenv("LEVELSET_CGAL_DATA");
-  return (env != nullptr && *env != '\0' ? fs::path(env) : fs::path(LEVELSET_CGAL_DATA)) / "meshes";
-}
-
 // Closed manifold inputs whose marching cubes surface at R = 128 legitimately changes topology,
 // because they have features thinner than about one voxel at that resolution (measured numbers
 // in each comment).
@@ -111,7 +106,7 @@ std::size_t stride_for(const TriangleMesh& from, const TriangleMesh& to) {
 }
 
 TEST(CgalSurfaces, ClosedManifoldInputsKeepTopologyAtR128BothMethods) {
-  const fs::path dir = cgal_meshes();
+  const fs::path dir = test::cgal_meshes_dir();
   if (!fs::is_directory(dir)) GTEST_SKIP() << "CGAL data meshes not installed: " << dir;
   std::vector<fs::path> files;
   for (const auto& entry : fs::directory_iterator(dir))
@@ -183,7 +178,7 @@ TEST(CgalSurfaces, ClosedManifoldInputsKeepTopologyAtR128BothMethods) {
 }
 
 TEST(CgalSurfaces, HausdorffWithinOneVoxelForKnotAndBunny) {
-  const fs::path dir = cgal_meshes();
+  const fs::path dir = test::cgal_meshes_dir();
   if (!fs::is_directory(dir)) GTEST_SKIP() << "CGAL data meshes not installed: " << dir;
   int checked = 0;
   for (const std::string name : {"knot.off", "bunny00.off"}) {
@@ -240,7 +235,7 @@ double first_hit(const TriangleMesh& m, std::size_t f, const Vec3d& o, const Vec
 }
 
 TEST(CgalSurfaces, DISABLED_ThicknessOfExcludedMeshes) {
-  const fs::path dir = cgal_meshes();
+  const fs::path dir = test::cgal_meshes_dir();
   if (!fs::is_directory(dir)) GTEST_SKIP();
   for (const std::string& name : kDiagnosed) {
     const TriangleMesh m = read_mesh(dir / name).mesh;
