@@ -215,16 +215,16 @@ class Scanner {
 };
 
 // The box of p0 + R d over a 2D cone of unit directions (between d1 and d2 through mid, angle
-// theta) and both edge ends, or the whole cylinder's box when the cone is wide.
+// with cosine cos_theta) and both edge ends, or the whole cylinder's box when the cone is wide.
 void wedge_box(Polyhedron& p, const Vec3d& p0, const Vec3d& p1, const Vec3d& d1, const Vec3d& d2, const Vec3d& mid,
-               double theta, double r) {
-  if (theta > 2.1) {  // wider than ~120 degrees: the cylinder's box
+               double cos_theta, double r) {
+  if (cos_theta < -0.5) {  // wider than 120 degrees: the cylinder's box
     const Vec3d e{r, r, r};
     p.lo = min(p0, p1) - e;
     p.hi = max(p0, p1) + e;
     return;
   }
-  const double bulge = r / std::max(0.5, std::cos(0.5 * theta));
+  const double bulge = r / std::max(0.5, std::sqrt(0.5 * (1.0 + cos_theta)));  // r / cos(theta / 2)
   const Vec3d pts[8] = {p0, p1, p0 + d1 * r, p0 + d2 * r, p1 + d1 * r, p1 + d2 * r, p0 + mid * bulge, p1 + mid * bulge};
   p.box_of(pts, 8);
 }
@@ -313,7 +313,7 @@ void scan_wedge(const TriangleMesh& mesh, const Adjacency& adj, const TriangleFr
       // onto the edge, on both prisms' boundaries (within their slack): nothing to add.
       if (length(sum) < 1e-9) return;
       {
-        wedge_box(p, p0, p1, d1, d2, unit(sum), std::acos(std::clamp(dot(d1, d2), -1.0, 1.0)), r + eps);
+        wedge_box(p, p0, p1, d1, d2, unit(sum), std::clamp(dot(d1, d2), -1.0, 1.0), r + eps);
       }
     }
   }
@@ -380,17 +380,17 @@ void scan_cone(const TriangleMesh& mesh, const Adjacency& adj, const TriangleFra
         else rays[nr++] = c;
       }
     }
-  double spread = 0;
+  double min_cos = 1.0;  // the cosine of the widest angle between two rays
   for (int i = 0; i < nr; ++i)
-    for (int j = i + 1; j < nr; ++j) spread = std::max(spread, std::acos(std::clamp(dot(rays[i], rays[j]), -1.0, 1.0)));
+    for (int j = i + 1; j < nr; ++j) min_cos = std::min(min_cos, dot(rays[i], rays[j]));
   // A flat vertex surrounded by its edges: its cone is the normal line, whose points project
   // onto the vertex, on every adjacent prism's boundary (within their slack): nothing to add.
   if (!capped && !overflow && nr >= 1 && is_line(rays, nr) && surrounds(dirs, nd, rays[0])) return;
   const Vec3d e{r + eps, r + eps, r + eps};
   p.lo = v - e;
   p.hi = v + e;
-  if (!capped && !overflow && nr >= 2 && spread <= 2.0) {
-    const double reach = 1.5 * (r + eps) / std::cos(0.5 * spread);
+  if (!capped && !overflow && nr >= 2 && min_cos >= -0.4) {  // at most ~114 degrees apart
+    const double reach = 1.5 * (r + eps) / std::sqrt(0.5 * (1.0 + min_cos));  // 1.5 R / cos(angle / 2)
     Vec3d pts[65];
     pts[0] = v;
     for (int i = 0; i < nr; ++i) pts[i + 1] = v + rays[i] * reach;
