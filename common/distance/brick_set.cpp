@@ -30,15 +30,6 @@ BrickSet dilate_bricks(const std::vector<Coord>& shell, int reach) {
                      std::int32_t(std::int64_t((k >> kBrickCoordBits) & mask) - off),
                      std::int32_t(std::int64_t((k >> (2 * kBrickCoordBits)) & mask) - off)};
   });
-  set.neighbours.assign(keys.size() * 27, kNoBrick);
-  tbb::parallel_for(std::size_t(0), keys.size(), [&](std::size_t i) {
-    for (int j = 0; j < 27; ++j) {
-      const Coord n = set.bricks[i] + Coord{j % 3 - 1, (j / 3) % 3 - 1, j / 9 - 1};
-      if (!brick_in_range(n)) continue;
-      const auto it = std::lower_bound(keys.begin(), keys.end(), brick_key(n));
-      if (it != keys.end() && *it == brick_key(n)) set.neighbours[i * 27 + j] = std::uint32_t(it - keys.begin());
-    }
-  });
   set.keys = std::move(keys);
   return set;
 }

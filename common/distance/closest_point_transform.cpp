@@ -116,7 +116,7 @@ void scan_triangle(const Vec3d& a, const Vec3d& b, const Vec3d& c, std::uint32_t
 
 // The slab scan: the exact distances of every voxel within `radius` voxels of the mesh, per
 // listed brick (lists binned with that margin): each brick scan-converts its triangles' slabs.
-ClosestTriangleField scan_shell(const TriangleMesh& mesh, const BrickTriangleLists& lists,
+ClosestTriangleField slab_scan(const TriangleMesh& mesh, const BrickTriangleLists& lists,
                                 const GridFrame& frame, double radius, const ProgressHook& progress) {
   const std::size_t nb = lists.bricks.size();
   ClosestTriangleField shell;
@@ -259,7 +259,7 @@ CptResult closest_point_transform(const TriangleMesh& mesh, const CptOptions& op
   ClosestTriangleField field;
   bool maybe_open = true;  // edges with an odd number of faces: open, the sign needs the margin
   if (slab) {
-    field = scan_shell(mesh, lists, options.frame, options.frame.half_width, options.progress);
+    field = slab_scan(mesh, lists, options.frame, options.frame.half_width, options.progress);
   } else {
     CharacteristicScanOptions scan;
     scan.frame = options.frame;
