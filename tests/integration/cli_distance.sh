@@ -109,6 +109,26 @@ if [ -f "$data/meshes/knot.off" ]; then
     || fail "cpt knot.off 2 threads"
   cmp -s "$dir/knot.lsg" "$dir/knot2.lsg" || fail "1 and 2 threads give different files"
   pass
+  # Both distance methods (characteristic polyhedra, each triangle's slab) give the same band;
+  # the stats say which ran; an unknown method is refused naming the choices.
+  for m in characteristic slab; do
+    "$bin" cpt "$data/meshes/knot.off" --resolution 96 --band 6 --method "$m" -o "$dir/knot_$m.lsg" \
+      --stats "$dir/knot_$m.json" > /dev/null || fail "cpt --method $m"
+  done
+  "$py" - "$dir/knot_characteristic.json" "$dir/knot_slab.json" <<'PY' || fail "cpt methods disagree"
+import json, sys
+a, b = (json.load(open(f)) for f in sys.argv[1:3])
+assert a["method"] == "characteristic" and b["method"] == "slab", (a["method"], b["method"])
+assert a["active_voxels"] == b["active_voxels"] > 10000, (a["active_voxels"], b["active_voxels"])
+assert a["distance_evaluations"] < 3 * a["active_voxels"], a["distance_evaluations"]
+PY
+  pass
+  if "$bin" cpt "$data/meshes/knot.off" --method fast -o "$dir/bad.lsg" 2> "$dir/bad_method.err" > /dev/null; then
+    fail "cpt --method fast accepted"
+  fi
+  grep -q "characteristic" "$dir/bad_method.err" || fail "cpt --method fast: $(cat "$dir/bad_method.err")"
+  [ -e "$dir/bad.lsg" ] && fail "cpt --method fast wrote its output"
+  pass
 fi
 
 # An open mesh (issue 14): CGAL's cube without its top face. The band closes the hole across
