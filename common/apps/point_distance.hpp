@@ -123,7 +123,11 @@ LocalFit one_sided_fit(const PointIndex& index, const Vec3d& x, const Vec3d& n, 
 // centroid fit's O(rho^2 H)) and no dependence on where the points lie around x, so it
 // needs no curvature correction; height_residual, the weighted RMS of the points' heights
 // about the quadric (times sqrt(n / (n - 6))), estimates the noise without the curvature's
-// sagitta that the plane fit's spread carries. has_height is false (height_offset 0) with fewer than 10
+// sagitta that the plane fit's spread carries. The patch's scale follows the data: with at
+// least 32 kept points a second quadric over the nearest half is fitted, and its offset taken
+// where the two differ by more than 1.5 of its standard errors (the large patch bent by detail
+// the quadric cannot follow; intersection of confidence intervals, Lepski).
+// has_height is false (height_offset 0) with fewer than 10
 // kept points or an ill-conditioned system. Thread-safe.
 struct SheetFit {
   LocalFit plane;

@@ -13,8 +13,9 @@
 //   --meshes a.off,b.off (only these)  --max-meshes N  --ours (no Poisson)  --list (the meshes
 //   and their measurements only)  --jsonl FILE (one record per case, appended)
 //   --cache DIR (Poisson's results by case, default reconstruct-sweep-cache; reused).
-//   Development: --levels L, --shell-offset S, --curvature-weight W (reconstruction options);
-//   --keep DIR writes each case's points (KEY-points.xyz) and our surface (KEY-ours.ply).
+//   Development: --levels L, --shell-offset S, --curvature-weight W, --free-distance F (reconstruction options);
+//   --keep DIR writes each case's points (KEY-points.xyz) and our surface (KEY-ours.ply);
+//   --log: the reconstruction's per-level lines with each level's topology on stderr.
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -57,8 +58,9 @@ struct SweepOptions {
   std::string jsonl, cache = "reconstruct-sweep-cache";
   // Development switches (not the defaults' measurement): reconstruction options.
   int levels = 0;
-  double shell_offset = 0, curvature_weight = -1;
+  double shell_offset = 0, curvature_weight = -1, free_distance = -1;
   std::string keep;
+  bool log = false;  // the reconstruction's per-level lines and topology on stderr
 };
 
 template <class T>
@@ -93,8 +95,10 @@ SweepOptions parse(int argc, char** argv) {
     else if (value && arg == "--shell-offset") o.shell_offset = std::atof(argv[++a]);
     else if (value && arg == "--curvature-weight") o.curvature_weight = std::atof(argv[++a]);
     else if (value && arg == "--keep") o.keep = argv[++a];
+    else if (value && arg == "--free-distance") o.free_distance = std::atof(argv[++a]);
     else if (arg == "--ours") o.ours_only = true;
     else if (arg == "--list") o.list_only = true;
+    else if (arg == "--log") o.log = true;
   }
   return o;
 }
@@ -258,6 +262,11 @@ CaseResult run_case(const SweepMesh& m, const std::vector<Vec3d>& truth_samples,
   if (o.levels > 0) ro.levels = o.levels;
   if (o.shell_offset > 0) ro.shell_offset = o.shell_offset;
   if (o.curvature_weight >= 0) ro.curvature_weight = o.curvature_weight;
+  if (o.free_distance >= 0) ro.free_distance = o.free_distance;
+  if (o.log) {
+    ro.log = [](const std::string& line) { std::fprintf(stderr, "  %s\n", line.c_str()); };
+    ro.log_topology = true;
+  }
   const auto t0 = std::chrono::steady_clock::now();
   try {
     const apps::ReconstructionResult r = apps::reconstruct_surface(points, ro);
