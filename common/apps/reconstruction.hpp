@@ -45,8 +45,12 @@
 //   evolve call (evolve/evolution.hpp, first-order upwind, forward Euler) stopped by
 //   stop_when once the mean front motion (|beta| dt over the voxels within one voxel of the
 //   front) is below tolerance voxels per step, or after max_steps.
-//   Finer levels, a snap: the band is resampled (trilinear) at half the voxel size; then
-//   snap_passes times: every voxel within 1 voxel of the front computes its front offset
+//   Finer levels, a snap: the band is resampled (trilinear) at half the voxel size; gaps the
+//   start shell closed are dug out where the points sampling their walls lie buried inside
+//   the front (carve_gaps; reconstruction_parts.hpp carve_buried_gaps: the empty space beside
+//   them, farther than the sampling gap from every point and reaching the outside, turned
+//   outside by simple flips only, so no handle is made; then at least 3 snap passes: homer's
+//   legs at 50k points, bench_reconstruct --sweep); then snap_passes times: every voxel within 1 voxel of the front computes its front offset
 //   e = clamp(s - u, -h, h) from fits of the points near the voxel (the others within 1.5
 //   voxels, which also move, take their neighbours' mean e) (point_distance.hpp
 //   sheet_fit: the nearest points less those off the near sheet along the normal, so a part
@@ -131,6 +135,7 @@ struct ReconstructionOptions {
   bool guard_flow = true;        // coarsest flow: refuse sign changes that change the topology (slower)
   bool guard_snaps = true;      // snaps: the same
   double free_distance = 1.0;   // flow guard: topology may change where the nearest point is farther (coarse voxels)
+  bool carve_gaps = true;       // finer levels: reopen gaps the start shell closed over buried points
   int max_resolution = 4096;    // cap on the final grid's longest side (voxels)
   ProgressHook progress;
   std::function<void(const std::string&)> log;  // progress lines; empty: none
@@ -152,6 +157,9 @@ struct ReconstructionStage {
   int height_neighbors = 0;     // snap: points per height fit (last pass)
   std::uint64_t refused_flips = 0;  // sign changes refused as not simple (topology kept), all steps / passes
   std::uint64_t dropped_components = 0;  // coarsest level: components without data turned to the other sign
+  std::uint64_t buried_points = 0;  // finer levels: points buried inside the upsampled front
+  int carved_regions = 0;           // finer levels: closed gaps reopened (turned outside)
+  std::uint64_t carved_voxels = 0;
   std::uint64_t active_voxels = 0;
   std::uint64_t fit_voxels = 0; // local fits computed (cache, or snapped voxels of all passes)
   double seconds = 0.0;         // whole level

@@ -4,6 +4,8 @@
 //                             fitted points, one guarded step at a time, strays dropped;
 //   reconstruction_snap.cpp   every finer level (and a single one): the snap of the front onto
 //                             the local fits, pass after pass;
+//   reconstruction_carve.cpp  gaps the start shell closed reopened where the points sampling
+//                             their walls lie buried inside the surface;
 //   reconstruction.cpp        validation, resolution and levels from the data, the levels in
 //                             order, the mesh.
 // Internal to levelset_core (namespace apps::detail). Units: world (the points centred on
@@ -11,6 +13,7 @@
 #pragma once
 
 #include <chrono>
+#include <cstdint>
 #include <vector>
 
 #include "apps/point_distance.hpp"
@@ -53,6 +56,39 @@ struct LevelOutput {
 LevelOutput flow_level(NarrowBand band, const PointIndex& index, const ReconstructionOptions& o, int levels,
                        ReconstructionStage stage);
 
+// ---- reconstruction_carve.cpp
+// Points deeper than max(kCarveDepthVoxels h, kCarveNoiseDepth noise) inside the front are
+// buried (a gap or tunnel the start shell closed: the points sampling its walls). The voxels
+// inside the front within reach_voxels of a buried point and farther than
+// clearance = max(h, kCarveNoiseDepth noise, gap) from every point form 6-connected regions;
+// a region that meets the outside (the shell spans the gap's mouth) and whose lining (points
+// within clearance + 1.5 h of its boundary) is at least kMinBuriedLining buried is turned
+// outside: a part's own interior beside buried points is lined by its surface's points, which
+// lie on the front. Nothing happens with fewer than max(kMinBuried, kMinBuriedShare N)
+// buried points. The band is rebuilt and redistanced when a region was carved.
+// Cost: O(N) band samples, O(buried * reach^3) candidate voxels and as many nearest-point
+// queries; nothing more without buried points.
+inline constexpr double kCarveDepthVoxels = 1.5;
+inline constexpr double kCarveNoiseDepth = 4.0;
+inline constexpr std::size_t kMinBuried = 16;
+inline constexpr double kMinBuriedShare = 5e-4;
+inline constexpr std::uint32_t kMinCarveVoxels = 8;
+inline constexpr double kMinBuriedLining = 0.5;
+struct CarveSettings {
+  double noise = 0.0;         // the points' noise estimate (world)
+  double gap = 0.0;           // the sampling's gap (world): clearance so a region does not leak between samples
+  double reach_voxels = 8.0;  // how far from a buried point regions are sought
+};
+struct CarveOutput {
+  NarrowBand band;
+  std::uint64_t buried = 0;         // points buried before carving
+  std::uint64_t carved_voxels = 0;  // turned outside
+  std::uint64_t refused = 0;        // left inside by the topology guard
+  int regions = 0;                  // regions carved
+};
+CarveOutput carve_buried_gaps(NarrowBand band, const PointIndex& index, const CarveSettings& settings,
+                              const ProgressHook& progress);
+
 // ---- reconstruction_snap.cpp
 // The last snap pass's noise estimates, in final voxels (they choose the next level's fits).
 struct SnapNoise {
@@ -62,6 +98,7 @@ struct SnapNoise {
 struct SnapLevel {
   int level = 0, levels = 1;
   double h_final = 0.0;
+  CarveSettings carve;  // level > 0 with ReconstructionOptions::carve_gaps: buried gaps reopened first
 };
 struct SnapOutput {
   NarrowBand band;

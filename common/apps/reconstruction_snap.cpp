@@ -92,6 +92,8 @@ constexpr double kResidualFloor = 0.1;
 // snap window take their neighbours' mean offset (the offset is nearly constant along the
 // normal; bench_reconstruct: the same Chamfer as fits on the whole window, 15% faster).
 constexpr double kFitWindow = 1.0;
+// Snap passes on a level where gaps were carved (reconstruction_carve.cpp).
+constexpr int kPassesAfterCarving = 3;
 
 // Mean curvature H = div(grad u / |grad u|) by central differences (u a distance, so the
 // 1 / |grad u|^3 normalisation is near 1); the 18 neighbours must be in the band.
@@ -336,10 +338,20 @@ SnapOutput snap_level(NarrowBand band, const PointIndex& index, const Reconstruc
   const std::vector<float> coarse_curvature = mean_curvature_field(coarse);
   const auto t_up = Clock::now();
   band = level > 0 ? upsample(coarse, W, o.progress) : coarse;
+  int passes = o.snap_passes;
+  if (level > 0 && o.carve_gaps) {
+    CarveOutput carved = carve_buried_gaps(std::move(band), index, where.carve, o.progress);
+    band = std::move(carved.band);
+    stage.buried_points = carved.buried;
+    stage.carved_regions = carved.regions;
+    stage.carved_voxels = carved.carved_voxels;
+    // The new walls lie about the clearance (a few voxels) off their points; a snap moves
+    // the front by at most a voxel per pass.
+    if (carved.regions > 0) passes = std::max(passes, kPassesAfterCarving);
+  }
   stage.seconds_start += seconds_since(t_up);
   // On the final level, clean data get clean_final_passes (the first pass's noise
   // estimate decides).
-  int passes = o.snap_passes;
   bool refine = false;  // after a clean pass: the front is within ~0.1 voxel of the fits
   int unredistanced = 0;  // passes since the last redistance
   for (int pass = 0; pass < passes; ++pass) {
@@ -386,7 +398,7 @@ SnapOutput snap_level(NarrowBand band, const PointIndex& index, const Reconstruc
     // 0.18 s less on bench_reconstruct's bunny at 20k).
     ++unredistanced;
     const bool last = pass + 1 == passes || stage.last_change < o.tolerance;
-    if (last || !snapped.clean) {
+    if (last || !snapped.clean || double(unredistanced) + 1.0 >= W) {  // the domain may grow W - 1 voxels at most
       const auto t_redistance = Clock::now();
       RedistanceOptions redo;
       redo.half_width = W;

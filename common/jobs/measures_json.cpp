@@ -42,6 +42,8 @@ nlohmann::json stages_json(const std::vector<apps::ReconstructionStage>& stages)
                       {"smoothing", s.smoothing},  {"second_order", s.second_order},
                       {"height_fits", s.height_fits}, {"height_neighbors", s.height_neighbors},
                       {"refused_flips", s.refused_flips}, {"dropped_components", s.dropped_components},
+                      {"buried_points", s.buried_points}, {"carved_regions", s.carved_regions},
+                      {"carved_voxels", s.carved_voxels},
                       {"active_voxels", s.active_voxels},
                       {"fit_voxels", s.fit_voxels}, {"seconds", s.seconds},
                       {"seconds_start", s.seconds_start}, {"seconds_fit", s.seconds_fit},

@@ -13,7 +13,7 @@
 //   --meshes a.off,b.off (only these)  --max-meshes N  --ours (no Poisson)  --list (the meshes
 //   and their measurements only)  --jsonl FILE (one record per case, appended)
 //   --cache DIR (Poisson's results by case, default reconstruct-sweep-cache; reused).
-//   Development: --levels L, --shell-offset S, --curvature-weight W, --free-distance F (reconstruction options);
+//   Development: --levels L, --shell-offset S, --curvature-weight W, --free-distance F, --no-carve (reconstruction options);
 //   --keep DIR writes each case's points (KEY-points.xyz) and our surface (KEY-ours.ply);
 //   --log: the reconstruction's per-level lines with each level's topology on stderr.
 #include <algorithm>
@@ -61,6 +61,7 @@ struct SweepOptions {
   double shell_offset = 0, curvature_weight = -1, free_distance = -1;
   std::string keep;
   bool log = false;  // the reconstruction's per-level lines and topology on stderr
+  bool no_carve = false;
 };
 
 template <class T>
@@ -99,6 +100,7 @@ SweepOptions parse(int argc, char** argv) {
     else if (arg == "--ours") o.ours_only = true;
     else if (arg == "--list") o.list_only = true;
     else if (arg == "--log") o.log = true;
+    else if (arg == "--no-carve") o.no_carve = true;
   }
   return o;
 }
@@ -263,6 +265,7 @@ CaseResult run_case(const SweepMesh& m, const std::vector<Vec3d>& truth_samples,
   if (o.shell_offset > 0) ro.shell_offset = o.shell_offset;
   if (o.curvature_weight >= 0) ro.curvature_weight = o.curvature_weight;
   if (o.free_distance >= 0) ro.free_distance = o.free_distance;
+  ro.carve_gaps = !o.no_carve;
   if (o.log) {
     ro.log = [](const std::string& line) { std::fprintf(stderr, "  %s\n", line.c_str()); };
     ro.log_topology = true;

@@ -1,0 +1,273 @@
+// reconstruct_surface's carving of buried gaps (reconstruction_parts.hpp): the start shell
+// closes gaps and tunnels narrower than its offset, and the topology guard keeps them closed;
+// the points sampling their walls then lie inside the surface. This finds those points and
+// turns the empty space beside them (inside the surface, away from every point) to outside.
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <numeric>
+#include <vector>
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+#include <tbb/parallel_sort.h>
+
+#include "apps/reconstruction_parts.hpp"
+#include "distance/redistance.hpp"
+#include "grid/band_accessor.hpp"
+#include "grid/band_builder.hpp"
+#include "grid/interpolate.hpp"
+#include "grid/topology_guard.hpp"
+
+namespace levelset::apps::detail {
+
+namespace {
+
+// A voxel key: 21 bits per axis after an offset (voxel indices of the level's grid).
+constexpr std::int64_t kKeyBias = 1 << 20;
+std::uint64_t key_of(const Coord& c) {
+  return (std::uint64_t(c.x + kKeyBias) << 42) | (std::uint64_t(c.y + kKeyBias) << 21) | std::uint64_t(c.z + kKeyBias);
+}
+Coord coord_of(std::uint64_t k) {
+  const std::int64_t mask = (std::int64_t{1} << 21) - 1;
+  return Coord{int(std::int64_t(k >> 42) - kKeyBias), int(std::int64_t((k >> 21) & std::uint64_t(mask)) - kKeyBias),
+               int(std::int64_t(k & std::uint64_t(mask)) - kKeyBias)};
+}
+
+std::uint32_t find_root(std::vector<std::uint32_t>& parent, std::uint32_t i) {
+  while (parent[i] != i) {
+    parent[i] = parent[parent[i]];
+    i = parent[i];
+  }
+  return i;
+}
+
+// Buried: the points lying deeper than `depth` inside the band's surface.
+std::vector<std::uint32_t> buried_points(const NarrowBand& band, const PointIndex& index, double depth) {
+  const std::size_t n = index.size();
+  std::vector<std::uint8_t> flag(n, 0);
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 4096), [&](const tbb::blocked_range<std::size_t>& r) {
+    BandAccessor acc(band);
+    for (std::size_t i = r.begin(); i != r.end(); ++i)
+      flag[i] = double(sample_trilinear(acc, band, index.points()[i])) < -depth;
+  });
+  std::vector<std::uint32_t> out;
+  for (std::size_t i = 0; i < n; ++i)
+    if (flag[i]) out.push_back(std::uint32_t(i));
+  return out;
+}
+
+
+// The band with the voxels `carved` (sorted keys) and their inside face neighbours active
+// (-h/2 where they were inactive; signs unchanged): bricks rebuilt through BandBuilder, the
+// untouched ones copied.
+NarrowBand with_active(const NarrowBand& band, const std::vector<std::uint64_t>& carved) {
+  const float half = float(0.5 * band.voxel_size());
+  struct Edit {
+    std::uint64_t brick;
+    Coord brick_coord;
+    int voxel;
+    bool carve;
+    bool operator<(const Edit& o) const { return brick < o.brick || (brick == o.brick && voxel < o.voxel); }
+  };
+  const Coord steps[6] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
+  std::vector<Edit> edits;
+  BandAccessor acc(band);
+  for (const std::uint64_t k : carved) {
+    const Coord c = coord_of(k);
+    edits.push_back({brick_key(brick_of(c)), brick_of(c), local_index(c), true});
+    for (const Coord& step : steps) {
+      const Coord q = c + step;
+      if (!std::binary_search(carved.begin(), carved.end(), key_of(q)) && acc.is_inside(q))
+        edits.push_back({brick_key(brick_of(q)), brick_of(q), local_index(q), false});
+    }
+  }
+  std::sort(edits.begin(), edits.end());
+  std::vector<Coord> bricks;  // every brick of the result: the band's and the edited ones
+  for (std::uint32_t b = 0; b < band.brick_count(); ++b) bricks.push_back(band.bricks()[b].coord);
+  for (std::size_t e = 0; e < edits.size(); ++e) {
+    if (e > 0 && edits[e].brick == edits[e - 1].brick) continue;
+    const Coord c = edits[e].brick_coord;
+    if (acc.locate(c) == kNoBrick) bricks.push_back(c);
+  }
+  BandBuilder builder(band.frame());
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, bricks.size(), 16), [&](const tbb::blocked_range<std::size_t>& r) {
+    BandAccessor local(band);
+    std::vector<float> values(kBrickVoxels);
+    for (std::size_t i = r.begin(); i != r.end(); ++i) {
+      const Coord bc = bricks[i];
+      const std::uint32_t b = local.locate(bc);
+      BrickMask active{}, inside{};
+      if (b != kNoBrick) {
+        active = band.bricks()[b].active;
+        inside = band.inside_mask(b);
+        std::size_t slot = band.bricks()[b].value_offset;
+        active.for_each_set([&](int n) { values[std::size_t(n)] = band.values()[slot++]; });
+      } else {
+        const Coord o = brick_origin(bc);
+        for (int n = 0; n < kBrickVoxels; ++n) inside.assign(n, local.is_inside(o + local_coord(n)));
+      }
+      const std::uint64_t key = brick_key(bc);
+      auto e = std::lower_bound(edits.begin(), edits.end(), Edit{key, bc, -1, false});
+      for (; e != edits.end() && e->brick == key; ++e) {
+        const int n = e->voxel;
+        if (!active.test(n)) values[std::size_t(n)] = -half;  // carved voxels are inside too
+        active.set(n);
+      }
+      builder.add_brick(bc, active, inside, values.data());
+    }
+  });
+  return builder.finish(band.far_inside());
+}
+
+}  // namespace
+
+CarveOutput carve_buried_gaps(NarrowBand band, const PointIndex& index, const CarveSettings& s,
+                              const ProgressHook& progress) {
+  CarveOutput out;
+  const double h = band.voxel_size();
+  const double depth = std::max(kCarveDepthVoxels * h, kCarveNoiseDepth * s.noise);
+  const double clearance = std::max({h, kCarveNoiseDepth * s.noise, s.gap});
+  const std::vector<std::uint32_t> buried = buried_points(band, index, depth);
+  out.buried = buried.size();
+  if (buried.size() < std::max<std::size_t>(kMinBuried, std::size_t(kMinBuriedShare * double(index.size()))))
+    return {std::move(band), out.buried};
+  progress.check("reconstruct carve");
+  // 1. Candidate voxels: within `reach` of a buried point, inside the surface, farther than
+  // `clearance` from every point (the empty space beside the buried walls, and the parts'
+  // own interiors beyond their walls: told apart below).
+  const int reach = int(std::ceil(s.reach_voxels));
+  std::vector<std::vector<std::uint64_t>> gathered(buried.size());
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, buried.size(), 64), [&](const tbb::blocked_range<std::size_t>& r) {
+    BandAccessor acc(band);
+    for (std::size_t b = r.begin(); b != r.end(); ++b) {
+      const Vec3d q = (index.points()[buried[b]] - band.origin()) / h;
+      const Coord c{int(std::lround(q.x)), int(std::lround(q.y)), int(std::lround(q.z))};
+      for (int dz = -reach; dz <= reach; ++dz)
+        for (int dy = -reach; dy <= reach; ++dy)
+          for (int dx = -reach; dx <= reach; ++dx) {
+            if (dx * dx + dy * dy + dz * dz > reach * reach) continue;
+            const Coord v{c.x + dx, c.y + dy, c.z + dz};
+            if (acc.is_inside(v)) gathered[b].push_back(key_of(v));
+          }
+    }
+  });
+  std::vector<std::uint64_t> keys;
+  for (auto& g : gathered) keys.insert(keys.end(), g.begin(), g.end());
+  std::vector<std::vector<std::uint64_t>>().swap(gathered);
+  tbb::parallel_sort(keys.begin(), keys.end());
+  keys.erase(std::unique(keys.begin(), keys.end()), keys.end());
+  std::vector<std::uint8_t> clear(keys.size(), 0);
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, keys.size(), 1024), [&](const tbb::blocked_range<std::size_t>& r) {
+    progress.check("reconstruct carve");
+    for (std::size_t i = r.begin(); i != r.end(); ++i)
+      clear[i] = index.nearest(band.world(coord_of(keys[i]))).distance > clearance;
+  });
+  std::vector<std::uint64_t> air;
+  for (std::size_t i = 0; i < keys.size(); ++i)
+    if (clear[i]) air.push_back(keys[i]);
+  std::vector<std::uint64_t>().swap(keys);
+  if (air.empty()) return {std::move(band), out.buried};
+  // 2. Regions: 6-connected components of the candidates.
+  auto find = [&](const Coord& c) -> std::int64_t {
+    const auto it = std::lower_bound(air.begin(), air.end(), key_of(c));
+    return it != air.end() && *it == key_of(c) ? std::int64_t(it - air.begin()) : -1;
+  };
+  const Coord steps[6] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
+  std::vector<std::uint32_t> parent(air.size());
+  std::iota(parent.begin(), parent.end(), 0u);
+  for (std::size_t i = 0; i < air.size(); ++i) {
+    const Coord c = coord_of(air[i]);
+    for (int k = 0; k < 6; k += 2) {  // + directions: each pair once
+      const std::int64_t j = find(c + steps[k]);
+      if (j < 0) continue;
+      const std::uint32_t a = find_root(parent, std::uint32_t(i)), b = find_root(parent, std::uint32_t(j));
+      if (a != b) parent[std::max(a, b)] = std::min(a, b);
+    }
+  }
+  // 3. A region is a closed gap when it meets the outside (the shell spans the gap's mouth)
+  // and the points lining it are mostly buried (a gap's walls); a part's own interior meets
+  // the outside only through a hole in the sampling, and its lining is the part's surface,
+  // mostly on the front.
+  std::vector<std::uint32_t> root(air.size());
+  for (std::size_t i = 0; i < air.size(); ++i) root[i] = find_root(parent, std::uint32_t(i));
+  std::vector<std::uint8_t> meets_outside(air.size(), 0);
+  std::vector<std::uint32_t> size(air.size(), 0);
+  std::vector<std::uint32_t> lining(air.size(), 0), lining_buried(air.size(), 0);
+  std::vector<std::uint8_t> is_buried(index.size(), 0);
+  for (const std::uint32_t p : buried) is_buried[p] = 1;
+  std::vector<std::uint32_t> seen_by(index.size(), std::uint32_t(-1));
+  std::vector<std::pair<std::uint32_t, double>> near;
+  BandAccessor acc(band);
+  for (std::size_t i = 0; i < air.size(); ++i) {
+    const Coord c = coord_of(air[i]);
+    const std::uint32_t r = root[i];
+    ++size[r];
+    bool boundary = false;
+    for (const Coord& step : steps) {
+      const Coord q = c + step;
+      if (find(q) >= 0) continue;
+      boundary = true;
+      if (!acc.is_inside(q)) meets_outside[r] = 1;
+    }
+    if (!boundary) continue;
+    index.within(band.world(c), clearance + 1.5 * h, near);
+    for (const auto& [p, d2] : near) {
+      if (seen_by[p] == r) continue;
+      seen_by[p] = r;
+      ++lining[r];
+      lining_buried[r] += is_buried[p];
+    }
+  }
+  std::vector<std::uint8_t> carve(air.size(), 0);
+  for (std::size_t i = 0; i < air.size(); ++i) {
+    const std::uint32_t r = root[i];
+    if (r != i) continue;
+    if (meets_outside[r] && size[r] >= kMinCarveVoxels &&
+        double(lining_buried[r]) >= kMinBuriedLining * double(lining[r])) {
+      carve[r] = 1;
+      ++out.regions;
+    }
+  }
+  std::vector<std::uint64_t> carved;
+  for (std::size_t i = 0; i < air.size(); ++i)
+    if (carve[root[i]]) carved.push_back(air[i]);
+  out.carved_voxels = carved.size();
+  if (carved.empty()) return {std::move(band), out.buried};
+  // 4. The carved voxels and their inside face neighbours join the band (-h/2 where they were
+  // inactive: every sign change stays between active voxels, the band's invariant); the
+  // carved ones turn outside (+h/2) as far as the topology guard lets them: simple flips
+  // only, taken again as their neighbours flip, so the region is dug out from the shell
+  // inward without making handles. Where only part of a gap could be cleared (a slot
+  // narrower than the clearance in places), removing what is left of the shell across it
+  // would open tunnels, and opening the rest would leave bridges: both change the genus.
+  // The band is then redistanced out to its half-width (the snaps that follow move the new
+  // walls onto the points).
+  NarrowBand active = with_active(band, carved);
+  std::vector<float> proposed(active.values().begin(), active.values().end());
+  {
+    BandAccessor at(active);
+    const float half = float(0.5 * h);
+    for (const std::uint64_t k : carved) {
+      const Coord c = coord_of(k);
+      const std::uint32_t b = at.locate(brick_of(c));
+      const Brick& br = active.bricks()[b];
+      proposed[br.value_offset + br.slot(local_index(c))] = half;
+    }
+  }
+  TopologyGuardOptions guard;
+  guard.eps = 1e-3 * h;
+  guard.progress = progress;
+  TopologyGuardResult kept = guard_topology(active, active, std::move(proposed), guard);
+  out.refused = kept.refused_flips;
+  out.carved_voxels = carved.size() - std::min<std::uint64_t>(carved.size(), kept.refused_flips);
+  active.swap_values(kept.values);
+  out.band = std::move(active);
+  RedistanceOptions redo;
+  redo.half_width = band.half_width();
+  redo.progress = progress;
+  out.band = redistance(reframed(out.band, {}, 1.0), redo).band;
+  return out;
+}
+
+}  // namespace levelset::apps::detail
