@@ -283,12 +283,12 @@ struct HeightFit {
   bool ok = false;
   double offset = 0.0;    // x's signed distance to the quadric (world)
   double residual = 0.0;  // weighted RMS residual, corrected for the 6 coefficients (world)
-  double spread = 0.0;    // standard error of c0 per unit noise: sqrt(y^T (sum w^2 phi phi^T) y), M y = e0
+  double spread = 0.0;    // with_spread: standard error of c0 per unit noise, sqrt(y^T (sum w^2 phi phi^T) y), M y = e0
 };
 
 // The weighted least-squares quadric z = c0 + c1 u + ... + c5 v^2 (u, v the tangential
 // coordinates over the largest radius R among the first `used` points, weights exp(-rho^2 / R^2)).
-HeightFit quadric_height(const TangentPoint* pts, int used) {
+HeightFit quadric_height(const TangentPoint* pts, int used, bool with_spread) {
   HeightFit f;
   if (used < 10) return f;
   double r2max = 0.0;
@@ -305,7 +305,7 @@ HeightFit quadric_height(const TangentPoint* pts, int used) {
       r[std::size_t(a)] += w * phi[a] * pts[i].z;
       for (int b = 0; b <= a; ++b) {
         M[std::size_t(a * 6 + b)] += w * phi[a] * phi[b];
-        M2[std::size_t(a * 6 + b)] += w * w * phi[a] * phi[b];
+        if (with_spread) M2[std::size_t(a * 6 + b)] += w * w * phi[a] * phi[b];
       }
     }
   }
@@ -316,12 +316,14 @@ HeightFit quadric_height(const TangentPoint* pts, int used) {
     }
   std::array<double, 36> L = M;
   if (!solve_spd<6>(L, r, kHeightConditioning)) return f;
-  std::array<double, 6> y{1.0, 0.0, 0.0, 0.0, 0.0, 0.0};
-  L = M;
-  solve_spd<6>(L, y, kHeightConditioning);  // factorises as above: succeeds
   double var = 0.0;
-  for (int a = 0; a < 6; ++a)
-    for (int b = 0; b < 6; ++b) var += y[std::size_t(a)] * M2[std::size_t(a * 6 + b)] * y[std::size_t(b)];
+  if (with_spread) {
+    std::array<double, 6> y{1.0, 0.0, 0.0, 0.0, 0.0, 0.0};
+    L = M;
+    solve_spd<6>(L, y, kHeightConditioning);  // factorises as above: succeeds
+    for (int a = 0; a < 6; ++a)
+      for (int b = 0; b < 6; ++b) var += y[std::size_t(a)] * M2[std::size_t(a * 6 + b)] * y[std::size_t(b)];
+  }
   // The surface crosses the normal line at x + z0 n; x's signed offset along the surface's
   // normal is -z0 cos(tilt), the slope (z_xi, z_eta) = (r1, r2) / R.
   const double slope2 = (r[1] * r[1] + r[2] * r[2]) * inv_r * inv_r;
@@ -361,7 +363,7 @@ SheetFit sheet_fit(const PointIndex& index, const Vec3d& x, const Vec3d& n, int 
     const Vec3d v = index.points()[sh.idx[std::size_t(i)]] - x;
     pts[std::size_t(used++)] = TangentPoint{dot(v, e1), dot(v, e2), dot(v, n)};
   }
-  HeightFit fit = quadric_height(pts.data(), used);
+  HeightFit fit = quadric_height(pts.data(), used, false);
   if (!fit.ok) return f;
   // The patch's scale from the data (intersection of confidence intervals, Lepski): the
   // large patch averages the noise, but where the surface bends more than a quadric
@@ -369,7 +371,7 @@ SheetFit sheet_fit(const PointIndex& index, const Vec3d& x, const Vec3d& n, int 
   // interval: then the small patch's (unbiased) offset is taken.
   const int small = std::max(kSmallPatch, used / kPatchRatio);
   if (used >= 2 * small) {
-    const HeightFit near = quadric_height(pts.data(), small);
+    const HeightFit near = quadric_height(pts.data(), small, true);
     if (near.ok && std::abs(fit.offset - near.offset) > kPatchConfidence * near.residual * near.spread) fit = near;
   }
   f.height_offset = fit.offset;

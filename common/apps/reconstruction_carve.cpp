@@ -130,8 +130,12 @@ CarveOutput carve_buried_gaps(NarrowBand band, const PointIndex& index, const Ca
   const double clearance = std::max({h, kCarveNoiseDepth * s.noise, s.gap});
   const std::vector<std::uint32_t> buried = buried_points(band, index, depth);
   out.buried = buried.size();
+  auto unchanged = [&] {
+    out.band = std::move(band);
+    return std::move(out);
+  };
   if (buried.size() < std::max<std::size_t>(kMinBuried, std::size_t(kMinBuriedShare * double(index.size()))))
-    return {std::move(band), out.buried};
+    return unchanged();
   progress.check("reconstruct carve");
   // 1. Candidate voxels: within `reach` of a buried point, inside the surface, farther than
   // `clearance` from every point (the empty space beside the buried walls, and the parts'
@@ -167,7 +171,7 @@ CarveOutput carve_buried_gaps(NarrowBand band, const PointIndex& index, const Ca
   for (std::size_t i = 0; i < keys.size(); ++i)
     if (clear[i]) air.push_back(keys[i]);
   std::vector<std::uint64_t>().swap(keys);
-  if (air.empty()) return {std::move(band), out.buried};
+  if (air.empty()) return unchanged();
   // 2. Regions: 6-connected components of the candidates.
   auto find = [&](const Coord& c) -> std::int64_t {
     const auto it = std::lower_bound(air.begin(), air.end(), key_of(c));
@@ -233,7 +237,7 @@ CarveOutput carve_buried_gaps(NarrowBand band, const PointIndex& index, const Ca
   for (std::size_t i = 0; i < air.size(); ++i)
     if (carve[root[i]]) carved.push_back(air[i]);
   out.carved_voxels = carved.size();
-  if (carved.empty()) return {std::move(band), out.buried};
+  if (carved.empty()) return unchanged();
   // 4. The carved voxels and their inside face neighbours join the band (-h/2 where they were
   // inactive: every sign change stays between active voxels, the band's invariant); the
   // carved ones turn outside (+h/2) as far as the topology guard lets them: simple flips
@@ -263,6 +267,14 @@ CarveOutput carve_buried_gaps(NarrowBand band, const PointIndex& index, const Ca
   out.carved_voxels = carved.size() - std::min<std::uint64_t>(carved.size(), kept.refused_flips);
   active.swap_values(kept.values);
   out.band = std::move(active);
+  for (const std::uint64_t k : carved) {
+    const Coord b = brick_of(coord_of(k));
+    for (int dz = -1; dz <= 1; ++dz)
+      for (int dy = -1; dy <= 1; ++dy)
+        for (int dx = -1; dx <= 1; ++dx) out.bricks.push_back(brick_key(b + Coord{dx, dy, dz}));
+  }
+  std::sort(out.bricks.begin(), out.bricks.end());
+  out.bricks.erase(std::unique(out.bricks.begin(), out.bricks.end()), out.bricks.end());
   RedistanceOptions redo;
   redo.half_width = band.half_width();
   redo.progress = progress;

@@ -85,6 +85,7 @@ struct CarveOutput {
   std::uint64_t carved_voxels = 0;  // turned outside
   std::uint64_t refused = 0;        // left inside by the topology guard
   int regions = 0;                  // regions carved
+  std::vector<std::uint64_t> bricks;  // brick_key of the bricks with carved voxels and their 26 neighbours, sorted
 };
 CarveOutput carve_buried_gaps(NarrowBand band, const PointIndex& index, const CarveSettings& settings,
                               const ProgressHook& progress);

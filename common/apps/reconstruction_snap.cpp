@@ -92,8 +92,10 @@ constexpr double kResidualFloor = 0.1;
 // snap window take their neighbours' mean offset (the offset is nearly constant along the
 // normal; bench_reconstruct: the same Chamfer as fits on the whole window, 15% faster).
 constexpr double kFitWindow = 1.0;
-// Snap passes on a level where gaps were carved (reconstruction_carve.cpp).
-constexpr int kPassesAfterCarving = 3;
+// Snap passes, before the level's own, on the bricks where gaps were carved
+// (reconstruction_carve.cpp): the new walls lie about the clearance (2-3 voxels) off their
+// points, and a snap moves the front by at most a voxel per pass.
+constexpr int kPassesAfterCarving = 2;
 
 // Mean curvature H = div(grad u / |grad u|) by central differences (u a distance, so the
 // 1 / |grad u|^3 normalisation is near 1); the 18 neighbours must be in the band.
@@ -179,6 +181,7 @@ struct SnapSettings {
   double fit_window = kFitWindow;  // voxels with their own fit (within the window)
   double h_final = 0.0;
   bool guard = true;             // keep the topology
+  const std::vector<std::uint64_t>* only = nullptr;  // when set: only voxels of these bricks (brick_key, sorted) move
 };
 
 // One snap pass (see the header): every voxel with |u| < window h takes the signed offset s
@@ -204,6 +207,9 @@ SnapPass snap_to_fits(NarrowBand& band, const PointIndex& index, const SnapSetti
                       progress.check("reconstruct snap");
                       BandAccessor acc(band), coarse_acc(coarse);
                       for (std::uint32_t b = r.begin(); b != r.end(); ++b) {
+                        if (settings.only && !std::binary_search(settings.only->begin(), settings.only->end(),
+                                                                 brick_key(band.bricks()[b].coord)))
+                          continue;
                         std::size_t slot = band.bricks()[b].value_offset;
                         band.for_each_active_in_brick(b, [&](const Coord& c, float value) {
                           const std::size_t i = slot++;
@@ -338,24 +344,17 @@ SnapOutput snap_level(NarrowBand band, const PointIndex& index, const Reconstruc
   const std::vector<float> coarse_curvature = mean_curvature_field(coarse);
   const auto t_up = Clock::now();
   band = level > 0 ? upsample(coarse, W, o.progress) : coarse;
-  int passes = o.snap_passes;
+  std::vector<std::uint64_t> carved_bricks;
   if (level > 0 && o.carve_gaps) {
     CarveOutput carved = carve_buried_gaps(std::move(band), index, where.carve, o.progress);
     band = std::move(carved.band);
     stage.buried_points = carved.buried;
     stage.carved_regions = carved.regions;
     stage.carved_voxels = carved.carved_voxels;
-    // The new walls lie about the clearance (a few voxels) off their points; a snap moves
-    // the front by at most a voxel per pass.
-    if (carved.regions > 0) passes = std::max(passes, kPassesAfterCarving);
+    carved_bricks = std::move(carved.bricks);
   }
   stage.seconds_start += seconds_since(t_up);
-  // On the final level, clean data get clean_final_passes (the first pass's noise
-  // estimate decides).
-  bool refine = false;  // after a clean pass: the front is within ~0.1 voxel of the fits
-  int unredistanced = 0;  // passes since the last redistance
-  for (int pass = 0; pass < passes; ++pass) {
-    const auto t_fit = Clock::now();
+  auto settings_for = [&](bool refine) {
     SnapSettings settings;
     settings.neighbors = o.neighbors;
     settings.height_neighbors = std::max(o.neighbors, kHeightNeighbors);
@@ -371,6 +370,31 @@ SnapOutput snap_level(NarrowBand band, const PointIndex& index, const Reconstruc
     settings.fit_window = refine ? kRefineWindow : kFitWindow;
     settings.h_final = h_final;
     settings.guard = o.guard_snaps;
+    return settings;
+  };
+  for (int pass = 0; !carved_bricks.empty() && pass < kPassesAfterCarving; ++pass) {
+    const auto t_fit = Clock::now();
+    SnapSettings settings = settings_for(false);
+    settings.only = &carved_bricks;
+    const SnapPass snapped = snap_to_fits(band, index, settings, coarse, coarse_curvature, o.progress);
+    stage.refused_flips += snapped.refused;
+    stage.fit_voxels += snapped.voxels;
+    stage.seconds_fit += seconds_since(t_fit);
+    const auto t_redistance = Clock::now();
+    RedistanceOptions redo;
+    redo.half_width = W;
+    redo.progress = o.progress;
+    band = redistance(reframed(band, {}, W - 1.0), redo).band;
+    stage.seconds_redistance += seconds_since(t_redistance);
+  }
+  // On the final level, clean data get clean_final_passes (the first pass's noise
+  // estimate decides).
+  int passes = o.snap_passes;
+  bool refine = false;  // after a clean pass: the front is within ~0.1 voxel of the fits
+  int unredistanced = 0;  // passes since the last redistance
+  for (int pass = 0; pass < passes; ++pass) {
+    const auto t_fit = Clock::now();
+    const SnapSettings settings = settings_for(refine);
     const SnapPass snapped = snap_to_fits(band, index, settings, coarse, coarse_curvature, o.progress);
     previous_noise = snapped.noise * h / h_final;
     previous_height_noise = snapped.height_noise * h / h_final;
