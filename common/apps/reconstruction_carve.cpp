@@ -134,7 +134,8 @@ CarveOutput carve_buried_gaps(NarrowBand band, const PointIndex& index, const Ca
     out.band = std::move(band);
     return std::move(out);
   };
-  if (buried.size() < std::max<std::size_t>(kMinBuried, std::size_t(kMinBuriedShare * double(index.size()))))
+  if (buried.size() < std::max<std::size_t>(kMinBuried, std::size_t(kMinBuriedShare * double(index.size()))) ||
+      double(buried.size()) > kMaxBuriedShare * double(index.size()))
     return unchanged();
   progress.check("reconstruct carve");
   // 1. Candidate voxels: within `reach` of a buried point, inside the surface, farther than

@@ -63,15 +63,20 @@ LevelOutput flow_level(NarrowBand band, const PointIndex& index, const Reconstru
 // clearance = max(h, kCarveNoiseDepth noise, gap) from every point form 6-connected regions;
 // a region that meets the outside (the shell spans the gap's mouth) and whose lining (points
 // within clearance + 1.5 h of its boundary) is at least kMinBuriedLining buried is turned
-// outside: a part's own interior beside buried points is lined by its surface's points, which
-// lie on the front. Nothing happens with fewer than max(kMinBuried, kMinBuriedShare N)
-// buried points. The band is rebuilt and redistanced when a region was carved.
+// outside, by simple flips only (grid/topology_guard.hpp: no handle is made or removed): a
+// part's own interior beside buried points is lined by its surface's points, which lie on
+// the front. Nothing happens with fewer than max(kMinBuried, kMinBuriedShare N) buried
+// points, or more than kMaxBuriedShare N (then the front is not near the data at all, and
+// the candidates would be ~reach^3 voxels per point: work and memory stay bounded). The band
+// is rebuilt (the carved voxels and their face neighbours active) and redistanced when a
+// region was carved; the caller snaps the new walls onto their points.
 // Cost: O(N) band samples, O(buried * reach^3) candidate voxels and as many nearest-point
-// queries; nothing more without buried points.
+// queries, the guard's work on the carved voxels; nothing more without buried points.
 inline constexpr double kCarveDepthVoxels = 1.5;
 inline constexpr double kCarveNoiseDepth = 4.0;
 inline constexpr std::size_t kMinBuried = 16;
 inline constexpr double kMinBuriedShare = 5e-4;
+inline constexpr double kMaxBuriedShare = 0.1;
 inline constexpr std::uint32_t kMinCarveVoxels = 8;
 inline constexpr double kMinBuriedLining = 0.5;
 struct CarveSettings {
