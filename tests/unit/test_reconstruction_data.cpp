@@ -115,19 +115,30 @@ TEST(Reconstruction, ResolutionAndLevelsFollowTheData) {
   EXPECT_EQ(reconstruct_surface(sample_shape_surface(*knot, s), o).stages.size(), 3u);
 }
 
+// CGAL's data/meshes/NAME and 50k points sampled on it (seed 1) with noise 0.1 % of its
+// bounding-box diagonal: the sweep's middle case (bench_reconstruct --sweep).
+struct CgalCase {
+  TriangleMesh truth;
+  std::vector<Vec3d> points;
+};
+CgalCase cgal_case(const char* name) {
+  CgalCase c;
+  c.truth = read_mesh(std::filesystem::path(LEVELSET_CGAL_DATA) / "meshes" / name).mesh;
+  SurfaceSampleOptions s;
+  s.count = 50000;
+  s.noise = 0.001 * length(c.truth.bounds().extent());
+  s.seed = 1;
+  c.points = sample_mesh_surface(c.truth, s);
+  return c;
+}
+
 TEST(Reconstruction, KeepsTheElephantsThreeHandles) {
   // CGAL's elephant (genus 3: the trunk, and the tusks, meet the body) from 50k points with
   // noise 0.1 % of the diagonal at resolution 256: the coarse level's start shell (offset 2
   // coarse voxels on 3 levels) closed two handles (genus 1) that the samples resolve.
-  const auto path = std::filesystem::path(LEVELSET_CGAL_DATA) / "meshes" / "elephant.off";
-  const TriangleMesh truth = read_mesh(path).mesh;
-  SurfaceSampleOptions s;
-  s.count = 50000;
-  s.noise = 0.001 * length(truth.bounds().extent());
-  s.seed = 1;
   ReconstructionOptions o;
   o.resolution = 256;
-  const ReconstructionResult r = reconstruct_surface(sample_mesh_surface(truth, s), o);
+  const ReconstructionResult r = reconstruct_surface(cgal_case("elephant.off").points, o);
   EXPECT_TRUE(r.measures.watertight);
   EXPECT_EQ(r.measures.components, 1u);
   EXPECT_EQ(r.measures.genus, 3.0);
@@ -138,13 +149,9 @@ TEST(Reconstruction, ReopensTheGapBetweenHomersLegsWithoutNewHandles) {
   // start shell spans the narrow gap between the legs, and the points sampling the legs'
   // inner sides end up buried inside the surface. Carving digs the gap out again (simple
   // flips only): the true surface comes closer to ours and the genus stays 0.
-  const auto path = std::filesystem::path(LEVELSET_CGAL_DATA) / "meshes" / "homer.off";
-  const TriangleMesh truth = read_mesh(path).mesh;
-  SurfaceSampleOptions s;
-  s.count = 50000;
-  s.noise = 0.001 * length(truth.bounds().extent());
-  s.seed = 1;
-  const std::vector<Vec3d> points = sample_mesh_surface(truth, s);
+  const CgalCase homer = cgal_case("homer.off");
+  const TriangleMesh& truth = homer.truth;
+  const std::vector<Vec3d>& points = homer.points;
   ReconstructionOptions o;
   o.resolution = 256;
   const ReconstructionResult carved = reconstruct_surface(points, o);
