@@ -283,46 +283,56 @@ struct HeightFit {
   bool ok = false;
   double offset = 0.0;    // x's signed distance to the quadric (world)
   double residual = 0.0;  // weighted RMS residual, corrected for the 6 coefficients (world)
-  double spread = 0.0;    // with_spread: standard error of c0 per unit noise, sqrt(y^T (sum w^2 phi phi^T) y), M y = e0
+  double spread = 0.0;    // kWithSpread: standard error of c0 per unit noise, sqrt(y^T (sum w^2 phi phi^T) y), M y = e0
 };
 
 // The weighted least-squares quadric z = c0 + c1 u + ... + c5 v^2 (u, v the tangential
 // coordinates over the largest radius R among the first `used` points, weights exp(-rho^2 / R^2)).
-HeightFit quadric_height(const TangentPoint* pts, int used, bool with_spread) {
+template <bool kWithSpread>
+HeightFit quadric_height(const TangentPoint* pts, int used) {
   HeightFit f;
   if (used < 10) return f;
   double r2max = 0.0;
   for (int i = 0; i < used; ++i) r2max = std::max(r2max, pts[i].xi * pts[i].xi + pts[i].eta * pts[i].eta);
   if (!(r2max > 0.0)) return f;
   const double inv_r = 1.0 / std::sqrt(r2max);
-  std::array<double, 36> M{}, M2{};
+  // Lower triangles, packed (a >= b, row by row); each point's weight kept for the residual.
+  std::array<double, 21> M{}, M2{};
   std::array<double, 6> r{};
+  std::array<double, kMaxNeighbors> weight;
   for (int i = 0; i < used; ++i) {
     const double u = pts[i].xi * inv_r, v = pts[i].eta * inv_r;
     const double w = std::exp(-(u * u + v * v));
+    weight[std::size_t(i)] = w;
     const double phi[6] = {1.0, u, v, u * u, u * v, v * v};
+    int k = 0;
     for (int a = 0; a < 6; ++a) {
-      r[std::size_t(a)] += w * phi[a] * pts[i].z;
-      for (int b = 0; b <= a; ++b) {
-        M[std::size_t(a * 6 + b)] += w * phi[a] * phi[b];
-        if (with_spread) M2[std::size_t(a * 6 + b)] += w * w * phi[a] * phi[b];
+      const double wa = w * phi[a];
+      r[std::size_t(a)] += wa * pts[i].z;
+      for (int b = 0; b <= a; ++b, ++k) M[std::size_t(k)] += wa * phi[b];
+      if constexpr (kWithSpread) {
+        const double w2a = w * w * phi[a];
+        for (int b = 0, k2 = k - a - 1; b <= a; ++b, ++k2) M2[std::size_t(k2)] += w2a * phi[b];
       }
     }
   }
-  for (int a = 0; a < 6; ++a)
-    for (int b = a + 1; b < 6; ++b) {
-      M[std::size_t(a * 6 + b)] = M[std::size_t(b * 6 + a)];
-      M2[std::size_t(a * 6 + b)] = M2[std::size_t(b * 6 + a)];
-    }
-  std::array<double, 36> L = M;
+  auto full = [](const std::array<double, 21>& packed) {
+    std::array<double, 36> m{};
+    int k = 0;
+    for (int a = 0; a < 6; ++a)
+      for (int b = 0; b <= a; ++b, ++k) m[std::size_t(a * 6 + b)] = m[std::size_t(b * 6 + a)] = packed[std::size_t(k)];
+    return m;
+  };
+  std::array<double, 36> L = full(M);
   if (!solve_spd<6>(L, r, kHeightConditioning)) return f;
   double var = 0.0;
-  if (with_spread) {
+  if constexpr (kWithSpread) {
     std::array<double, 6> y{1.0, 0.0, 0.0, 0.0, 0.0, 0.0};
-    L = M;
+    L = full(M);
     solve_spd<6>(L, y, kHeightConditioning);  // factorises as above: succeeds
+    const std::array<double, 36> S = full(M2);
     for (int a = 0; a < 6; ++a)
-      for (int b = 0; b < 6; ++b) var += y[std::size_t(a)] * M2[std::size_t(a * 6 + b)] * y[std::size_t(b)];
+      for (int b = 0; b < 6; ++b) var += y[std::size_t(a)] * S[std::size_t(a * 6 + b)] * y[std::size_t(b)];
   }
   // The surface crosses the normal line at x + z0 n; x's signed offset along the surface's
   // normal is -z0 cos(tilt), the slope (z_xi, z_eta) = (r1, r2) / R.
@@ -334,7 +344,7 @@ HeightFit quadric_height(const TangentPoint* pts, int used, bool with_spread) {
   double wsum = 0.0, rsum = 0.0;
   for (int i = 0; i < used; ++i) {
     const double u = pts[i].xi * inv_r, v = pts[i].eta * inv_r;
-    const double w = std::exp(-(u * u + v * v));
+    const double w = weight[std::size_t(i)];
     const double z = r[0] + r[1] * u + r[2] * v + r[3] * u * u + r[4] * u * v + r[5] * v * v;
     const double e = pts[i].z - z;
     wsum += w;
@@ -363,7 +373,7 @@ SheetFit sheet_fit(const PointIndex& index, const Vec3d& x, const Vec3d& n, int 
     const Vec3d v = index.points()[sh.idx[std::size_t(i)]] - x;
     pts[std::size_t(used++)] = TangentPoint{dot(v, e1), dot(v, e2), dot(v, n)};
   }
-  HeightFit fit = quadric_height(pts.data(), used, false);
+  HeightFit fit = quadric_height<false>(pts.data(), used);
   if (!fit.ok) return f;
   // The patch's scale from the data (intersection of confidence intervals, Lepski): the
   // large patch averages the noise, but where the surface bends more than a quadric
@@ -371,7 +381,7 @@ SheetFit sheet_fit(const PointIndex& index, const Vec3d& x, const Vec3d& n, int 
   // interval: then the small patch's (unbiased) offset is taken.
   const int small = std::max(kSmallPatch, used / kPatchRatio);
   if (used >= 2 * small) {
-    const HeightFit near = quadric_height(pts.data(), small, true);
+    const HeightFit near = quadric_height<true>(pts.data(), small);
     if (near.ok && std::abs(fit.offset - near.offset) > kPatchConfidence * near.residual * near.spread) fit = near;
   }
   f.height_offset = fit.offset;
