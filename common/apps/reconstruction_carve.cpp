@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <iterator>
 #include <numeric>
 #include <vector>
 
@@ -22,6 +23,9 @@
 namespace levelset::apps::detail {
 
 namespace {
+
+// Buried points per candidate-gathering chunk (each gathers up to ~(4/3) pi reach^3 keys).
+constexpr std::size_t kCarveChunk = 2048;
 
 // A voxel key: 21 bits per axis after an offset (voxel indices of the level's grid).
 constexpr std::int64_t kKeyBias = 1 << 20;
@@ -142,26 +146,37 @@ CarveOutput carve_buried_gaps(NarrowBand band, const PointIndex& index, const Ca
   // `clearance` from every point (the empty space beside the buried walls, and the parts'
   // own interiors beyond their walls: told apart below).
   const int reach = int(std::ceil(s.reach_voxels));
-  std::vector<std::vector<std::uint64_t>> gathered(buried.size());
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, buried.size(), 64), [&](const tbb::blocked_range<std::size_t>& r) {
-    BandAccessor acc(band);
-    for (std::size_t b = r.begin(); b != r.end(); ++b) {
-      const Vec3d q = (index.points()[buried[b]] - band.origin()) / h;
-      const Coord c{int(std::lround(q.x)), int(std::lround(q.y)), int(std::lround(q.z))};
-      for (int dz = -reach; dz <= reach; ++dz)
-        for (int dy = -reach; dy <= reach; ++dy)
-          for (int dx = -reach; dx <= reach; ++dx) {
-            if (dx * dx + dy * dy + dz * dz > reach * reach) continue;
-            const Coord v{c.x + dx, c.y + dy, c.z + dz};
-            if (acc.is_inside(v)) gathered[b].push_back(key_of(v));
-          }
-    }
-  });
+  // In chunks of buried points, each chunk's keys deduplicated and merged: the transient
+  // memory is a chunk's balls, not every buried point's.
   std::vector<std::uint64_t> keys;
-  for (auto& g : gathered) keys.insert(keys.end(), g.begin(), g.end());
-  std::vector<std::vector<std::uint64_t>>().swap(gathered);
-  tbb::parallel_sort(keys.begin(), keys.end());
-  keys.erase(std::unique(keys.begin(), keys.end()), keys.end());
+  for (std::size_t first = 0; first < buried.size(); first += kCarveChunk) {
+    progress.check("reconstruct carve");
+    const std::size_t last = std::min(buried.size(), first + kCarveChunk);
+    std::vector<std::vector<std::uint64_t>> gathered(last - first);
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(first, last, 64), [&](const tbb::blocked_range<std::size_t>& r) {
+      BandAccessor acc(band);
+      for (std::size_t b = r.begin(); b != r.end(); ++b) {
+        const Vec3d q = (index.points()[buried[b]] - band.origin()) / h;
+        const Coord c{int(std::lround(q.x)), int(std::lround(q.y)), int(std::lround(q.z))};
+        for (int dz = -reach; dz <= reach; ++dz)
+          for (int dy = -reach; dy <= reach; ++dy)
+            for (int dx = -reach; dx <= reach; ++dx) {
+              if (dx * dx + dy * dy + dz * dz > reach * reach) continue;
+              const Coord v{c.x + dx, c.y + dy, c.z + dz};
+              if (acc.is_inside(v)) gathered[b - first].push_back(key_of(v));
+            }
+      }
+    });
+    std::vector<std::uint64_t> chunk;
+    for (auto& g : gathered) chunk.insert(chunk.end(), g.begin(), g.end());
+    std::vector<std::vector<std::uint64_t>>().swap(gathered);
+    tbb::parallel_sort(chunk.begin(), chunk.end());
+    chunk.erase(std::unique(chunk.begin(), chunk.end()), chunk.end());
+    std::vector<std::uint64_t> merged;
+    merged.reserve(keys.size() + chunk.size());
+    std::set_union(keys.begin(), keys.end(), chunk.begin(), chunk.end(), std::back_inserter(merged));
+    keys.swap(merged);
+  }
   std::vector<std::uint8_t> clear(keys.size(), 0);
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, keys.size(), 1024), [&](const tbb::blocked_range<std::size_t>& r) {
     progress.check("reconstruct carve");
