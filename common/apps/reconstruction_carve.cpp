@@ -252,7 +252,6 @@ CarveOutput carve_buried_gaps(NarrowBand band, const PointIndex& index, const Ca
   std::vector<std::uint64_t> carved;
   for (std::size_t i = 0; i < air.size(); ++i)
     if (carve[root[i]]) carved.push_back(air[i]);
-  out.carved_voxels = carved.size();
   if (carved.empty()) return unchanged();
   // 4. The carved voxels and their inside face neighbours join the band (-h/2 where they were
   // inactive: every sign change stays between active voxels, the band's invariant); the
@@ -279,7 +278,6 @@ CarveOutput carve_buried_gaps(NarrowBand band, const PointIndex& index, const Ca
   guard.eps = 1e-3 * h;
   guard.progress = progress;
   TopologyGuardResult kept = guard_topology(active, active, std::move(proposed), guard);
-  out.refused = kept.refused_flips;
   out.carved_voxels = carved.size() - std::min<std::uint64_t>(carved.size(), kept.refused_flips);
   active.swap_values(kept.values);
   out.band = std::move(active);

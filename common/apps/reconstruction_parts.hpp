@@ -87,8 +87,7 @@ struct CarveSettings {
 struct CarveOutput {
   NarrowBand band;
   std::uint64_t buried = 0;         // points buried before carving
-  std::uint64_t carved_voxels = 0;  // turned outside
-  std::uint64_t refused = 0;        // left inside by the topology guard
+  std::uint64_t carved_voxels = 0;  // turned outside (the topology guard left the others inside)
   int regions = 0;                  // regions carved
   std::vector<std::uint64_t> bricks;  // brick_key of the bricks with carved voxels and their 26 neighbours, sorted
 };
