@@ -98,23 +98,48 @@ void add_phases(EvolutionResult& result, const OperatorOutput& op) {
 
 // One time step's values from `cur` and its rates `op` (forward Euler, or TVD-RK3 with two
 // more operator evaluations), retried with half the step while a sign changes in the edge
-// layer (a land mine: the band's edge holds no PDE), at most 5 times.
+// layer (a land mine: the band's edge holds no PDE), at most 5 times. `cur` holds u0 again on
+// return; the stages swap their values in and out (no copies). finite: every new value is.
 struct Advanced {
   std::vector<float> values;
-  bool mine = false;
+  bool mine = false, finite = true;
   double dt = 0;
 };
+
+// next[i] = value(i) for every i, in parallel; whether a sign changed against u0 at an edge
+// voxel (a land mine) and whether every value is finite, in the same pass.
+template <typename Value>
+void finish_stage(const float* u0, const std::vector<std::uint8_t>& edge, std::vector<float>& next, Value&& value,
+                  bool& mine, bool& finite) {
+  std::atomic<bool> fired{false}, bad{false};
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, next.size(), 1 << 14), [&](const tbb::blocked_range<std::size_t>& r) {
+    bool f = false, nf = false;
+    for (std::size_t i = r.begin(); i != r.end(); ++i) {
+      const float v = value(i);
+      next[i] = v;
+      f |= edge[i] && ((u0[i] < 0.0f) != (v < 0.0f));
+      nf |= !std::isfinite(v);
+    }
+    if (f) fired.store(true, std::memory_order_relaxed);
+    if (nf) bad.store(true, std::memory_order_relaxed);
+  });
+  mine = fired.load();
+  finite = !bad.load();
+}
+
 Advanced advance(NarrowBand& cur, const OperatorOutput& op, const OperatorSetup& setup, double dt, int rk_order,
                  EvolutionResult& result) {
   const double t = setup.time;
-  std::vector<float> next;
-  bool mine = false;
+  std::vector<float> next(cur.active_voxel_count());
+  bool mine = false, finite = true;
   for (int attempt = 0; attempt < 5; ++attempt) {
     auto t1 = Clock::now();
-    const std::vector<float> u0(cur.values().begin(), cur.values().end());
-    next.resize(u0.size());
-    for_each_value(u0.size(), [&](std::size_t i) { next[i] = float(double(u0[i]) + dt * double(op.rate[i])); });
-    if (rk_order == 3) {
+    const float* u0 = cur.values().data();
+    if (rk_order == 1) {
+      finish_stage(u0, op.edge, next, [&](std::size_t i) { return float(double(u0[i]) + dt * double(op.rate[i])); },
+                   mine, finite);
+    } else {
+      for_each_value(next.size(), [&](std::size_t i) { next[i] = float(double(u0[i]) + dt * double(op.rate[i])); });
       // Stages are evaluated on `cur` with its values swapped out and back (no band copy).
       OperatorSetup s2 = setup;
       s2.want_edges = false;
@@ -125,10 +150,10 @@ Advanced advance(NarrowBand& cur, const OperatorOutput& op, const OperatorSetup&
       OperatorOutput o1 = run_operator(cur, s2);
       cur.swap_values(next);  // back: next holds u1
       add_phases(result, o1);
-      std::vector<float> r1 = std::move(o1.rate);
+      const std::vector<float> r1 = std::move(o1.rate);
       result.seconds.operator_eval += since(t2);
-      std::vector<float> u2(u0.size());
-      for_each_value(u0.size(), [&](std::size_t i) {
+      std::vector<float> u2(next.size());
+      for_each_value(next.size(), [&](std::size_t i) {
         u2[i] = float(0.75 * u0[i] + 0.25 * (double(next[i]) + dt * double(r1[i])));
       });
       cur.swap_values(u2);  // cur holds u2
@@ -137,23 +162,18 @@ Advanced advance(NarrowBand& cur, const OperatorOutput& op, const OperatorSetup&
       OperatorOutput o2 = run_operator(cur, s2);
       cur.swap_values(u2);  // back
       add_phases(result, o2);
-      std::vector<float> r2 = std::move(o2.rate);
+      const std::vector<float> r2 = std::move(o2.rate);
       result.seconds.operator_eval += since(t2);
-      for_each_value(u0.size(), [&](std::size_t i) {
-        next[i] = float(u0[i] / 3.0 + 2.0 / 3.0 * (double(u2[i]) + dt * double(r2[i])));
-      });
+      finish_stage(u0, op.edge, next,
+                   [&](std::size_t i) { return float(u0[i] / 3.0 + 2.0 / 3.0 * (double(u2[i]) + dt * double(r2[i]))); },
+                   mine, finite);
     }
-    std::atomic<bool> fired{false};
-    for_each_value(u0.size(), [&](std::size_t i) {
-      if (op.edge[i] && ((u0[i] < 0.0f) != (next[i] < 0.0f))) fired.store(true, std::memory_order_relaxed);
-    });
-    mine = fired.load();
     result.seconds.update += since(t1);
     if (!mine || attempt == 4) break;
     ++result.landmine_count;
     dt *= 0.5;
   }
-  return {std::move(next), mine, dt};
+  return {std::move(next), mine, finite, dt};
 }
 
 // The edge layer from the new interior values (EdgeStencil), on its own side only.
@@ -291,11 +311,11 @@ EvolutionResult evolve(const NarrowBand& band, const EvolutionOptions& options) 
     if (options.time > 0) dt = std::min(dt, options.time - t);
 
     // RK stages; land mines halve dt and retry.
-    const Advanced adv = advance(cur, op, setup, dt, options.rk_order, result);
+    Advanced adv = advance(cur, op, setup, dt, options.rk_order, result);
     std::vector<float> next = std::move(adv.values);
     const bool mine = adv.mine;
     dt = adv.dt;
-    const std::string bad = first_non_finite(cur, next);
+    const std::string bad = adv.finite ? std::string() : first_non_finite(cur, next);
     if (!bad.empty()) {
       result.stop = StopReason::NonFinite;
       std::ostringstream msg;

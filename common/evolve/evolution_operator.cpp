@@ -43,6 +43,9 @@ struct Scratch {
   std::unique_ptr<struct AxisLines> lines;
   std::array<Vec3d, kBrickVoxels> vel;
   std::array<int, kBrickVoxels> curvature_at_tile;  // tile index whose curvature a voxel takes; -1: none
+  // Per brick row (y + 8 z), bit x: the voxel's 19-point curvature stencil is all active
+  // (whole), its six face neighbours are active (interior).
+  std::array<std::uint8_t, kBrickDim * kBrickDim> whole, interior;
 };
 
 bool active_at(const Scratch& s, int x, int y, int z) {
@@ -91,6 +94,23 @@ int curvature_source(const Scratch& s, const Coord& l) {
     if (best == p) return -1;
     p = best;
   }
+}
+
+// Scratch::whole and Scratch::interior from the tile's active rows, a row at a time: bit i of
+// three(r) says bits i - 1, i and i + 1 of r are set.
+void stencil_rows(Scratch& s) {
+  auto row = [&](int y, int z) { return s.rows[std::size_t((y - kLo) + kDim * (z - kLo))]; };
+  auto three = [](std::uint32_t r) { return r & (r >> 1) & (r << 1); };
+  for (int z = 0; z < kBrickDim; ++z)
+    for (int y = 0; y < kBrickDim; ++y) {
+      const std::uint32_t faces =
+          three(row(y, z)) & row(y - 1, z) & row(y + 1, z) & row(y, z - 1) & row(y, z + 1);
+      const std::uint32_t whole = three(row(y, z)) & three(row(y - 1, z)) & three(row(y + 1, z)) &
+                                  three(row(y, z - 1)) & three(row(y, z + 1)) & row(y - 1, z - 1) &
+                                  row(y - 1, z + 1) & row(y + 1, z - 1) & row(y + 1, z + 1);
+      s.interior[std::size_t(y + kBrickDim * z)] = std::uint8_t(faces >> -kLo);
+      s.whole[std::size_t(y + kBrickDim * z)] = std::uint8_t(whole >> -kLo);
+    }
 }
 
 bool is_edge(const Scratch& s, const Coord& l) {
@@ -255,6 +275,7 @@ void brick_operator(const NarrowBand& band, std::uint32_t b, const OperatorSetup
   const double h = band.voxel_size();
   const Neighborhood around = brick_neighborhood(band, b);
   gather_box(band, around, kLo, kHi, s.tile, s.rows);
+  stencil_rows(s);
   if (upwind) {
     if (!s.lines) s.lines = std::make_unique<AxisLines>();
     fill_axis_lines(s, stencil_reach(o.scheme), *s.lines);
@@ -315,7 +336,9 @@ void brick_operator(const NarrowBand& band, std::uint32_t b, const OperatorSetup
       g = Vec3d{double(v[1]) - double(v[-1]), double(v[kDim]) - double(v[-kDim]),
                 double(v[kDim * kDim]) - double(v[-kDim * kDim])} * (0.5 / h);
     const double gn = want_grad ? length(g) : 0.0;
-    if (needs & (kNeedsMean | kNeedsPrincipal | kNeedsGauss)) s.curvature_at_tile[std::size_t(k)] = curvature_source(s, l);
+    if (needs & (kNeedsMean | kNeedsPrincipal | kNeedsGauss))
+      s.curvature_at_tile[std::size_t(k)] =
+          (s.whole[std::size_t(l.y + kBrickDim * l.z)] >> l.x) & 1u ? tile_index(l.x, l.y, l.z) : curvature_source(s, l);
     s.grad[std::size_t(k)] = float(gn);
     if (needs & kNeedsNormal) {
       const Vec3d nrm = gn > 0 ? g / gn : Vec3d{};
@@ -335,7 +358,7 @@ void brick_operator(const NarrowBand& band, std::uint32_t b, const OperatorSetup
     if (setup.want_edges)
       stats.crossings += unsigned((v[0] < 0.0f) != (v[1] < 0.0f)) + unsigned((v[0] < 0.0f) != (v[kDim] < 0.0f)) +
                          unsigned((v[0] < 0.0f) != (v[kDim * kDim] < 0.0f));
-    if (setup.want_edges && is_edge(s, l)) {
+    if (setup.want_edges && !((s.interior[std::size_t(l.y + kBrickDim * l.z)] >> l.x) & 1u)) {
       out.edge[first + std::size_t(k)] = 1;
       EdgeStencil e = edge_stencil(band, around, s, l);
       if (e.count > 0) {
@@ -445,7 +468,7 @@ void brick_operator(const NarrowBand& band, std::uint32_t b, const OperatorSetup
     out.rate[first + u] = float(rate);
     const double vsum = std::abs(vel.x) + std::abs(vel.y) + std::abs(vel.z);
     stats.max_hyp = std::max(stats.max_hyp, kSqrt3 * std::abs(ba) + vsum);
-    const double sp = std::abs(ba) + std::abs(bp) + length(vel);
+    const double sp = std::abs(ba) + std::abs(bp) + (velocity ? length(vel) : 0.0);
     stats.max_speed = std::max(stats.max_speed, sp);
     // The front's speed: voxels next to the zero level only (curvatures blow up near the
     // skeleton, deep in the band, without the front moving).

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <bit>
+#include <cstring>
 #include <string>
 
 #include "core/error.hpp"
@@ -151,13 +152,27 @@ void gather_box(const NarrowBand& band, const Neighborhood& around, int lo, int 
             // dx * kBrickDim - lo is negative for dx = -1, so no pointer is formed from it
             // (UBSan: pointer overflow); the unsigned sum wraps back exactly.
             const std::size_t base = row - std::size_t(lo - dx * kBrickDim);
-            // Branch-free per voxel: the value's address is selected, not branched on (the
-            // active pattern of a row is unpredictable).
+            // Otherwise branch-free per voxel: the value's address is selected, not branched on
+            // (the active pattern of a partial row is unpredictable).
             const float* row_values = vals + rank_z + std::popcount(act_word & ((std::uint64_t{1} << bit0) - 1));
             const std::uint32_t before = kActiveBefore[act];
-            for (int x = nlo[0]; x < nhi[0]; ++x) {
-              const float* src = ((act >> x) & 1u) ? row_values + ((before >> (4 * x)) & 15u) : &sign_value[(ins >> x) & 1u];
-              out[base + std::size_t(x)] = *src;
+            if ((act & xmask) == xmask) {
+              // Every voxel of the range active (most rows of a wide band): one contiguous copy.
+              const float* src = row_values + ((before >> (4 * nlo[0])) & 15u);
+              float* dst = &out[base + std::size_t(nlo[0])];
+              if (width == kBrickDim) {
+                std::array<float, kBrickDim> row;  // fixed size: two vector moves, no memmove call
+                std::memcpy(row.data(), src, sizeof row);
+                std::memcpy(dst, row.data(), sizeof row);
+              } else {
+                for (int x = 0; x < width; ++x) dst[x] = src[x];
+              }
+            } else {
+              for (int x = nlo[0]; x < nhi[0]; ++x) {
+                const float* src =
+                    ((act >> x) & 1u) ? row_values + ((before >> (4 * x)) & 15u) : &sign_value[(ins >> x) & 1u];
+                out[base + std::size_t(x)] = *src;
+              }
             }
             if (rows)
               active_rows[std::size_t(y + dy * kBrickDim - lo) + dim * std::size_t(z + dz * kBrickDim - lo)] |=
