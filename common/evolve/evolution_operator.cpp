@@ -16,6 +16,7 @@
 #include <tbb/parallel_for.h>
 
 #include "evolve/curvature.hpp"
+#include "evolve/curvature_batch.hpp"
 #include "grid/band_accessor.hpp"
 #include "grid/interpolate.hpp"
 #include "grid/tile.hpp"
@@ -138,6 +139,7 @@ std::uint32_t value_index(const NarrowBand& band, const Neighborhood& around, co
 EdgeStencil edge_stencil(const NarrowBand& band, const Neighborhood& around, const Scratch& s, const Coord& l) {
   EdgeStencil e;
   double step = -1.0;
+  int best_face = -1, best_count = 0;
   for (int f = 0; f < 6; ++f) {
     const int a = f >> 1, dir = (f & 1) ? 1 : -1;
     Coord q[3] = {l, l, l};
@@ -151,16 +153,23 @@ EdgeStencil edge_stencil(const NarrowBand& band, const Neighborhood& around, con
     const double u1 = t[tile_index(q[0].x, q[0].y, q[0].z)], u2 = t[tile_index(q[1].x, q[1].y, q[1].z)];
     if (std::abs(u1 - u2) <= step) continue;
     step = std::abs(u1 - u2);
-    e.count = std::uint8_t(n);
-    for (int k = 0; k < n; ++k) e.source[std::size_t(k)] = value_index(band, around, q[k]);
-    e.coef = n == 3 ? std::array<float, 3>{3.0f, -3.0f, 1.0f} : std::array<float, 3>{2.0f, -1.0f, 0.0f};
+    best_face = f;
+    best_count = n;
   }
-  if (e.count > 0)
-    for (int f = 0; f < 6; ++f) {
-      Coord q = l;
-      q[f >> 1] += (f & 1) ? 1 : -1;
-      if (active_at(s, q.x, q.y, q.z)) e.neighbor[e.neighbors++] = value_index(band, around, q);
-    }
+  if (best_face < 0) return e;
+  // Band value indices for the chosen direction only.
+  e.count = std::uint8_t(best_count);
+  for (int k = 0; k < best_count; ++k) {
+    Coord q = l;
+    q[best_face >> 1] += ((best_face & 1) ? 1 : -1) * (k + 1);
+    e.source[std::size_t(k)] = value_index(band, around, q);
+  }
+  e.coef = best_count == 3 ? std::array<float, 3>{3.0f, -3.0f, 1.0f} : std::array<float, 3>{2.0f, -1.0f, 0.0f};
+  for (int f = 0; f < 6; ++f) {
+    Coord q = l;
+    q[f >> 1] += (f & 1) ? 1 : -1;
+    if (active_at(s, q.x, q.y, q.z)) e.neighbor[e.neighbors++] = value_index(band, around, q);
+  }
   return e;
 }
 
@@ -259,8 +268,8 @@ struct OperatorStats {
 };
 
 // The spatial operator on one brick: rates (and betas, edges) for its active voxels.
-void brick_operator(const NarrowBand& band, std::uint32_t b, const OperatorSetup& setup, Scratch& s,
-                    OperatorOutput& out, OperatorStats& stats) {
+void brick_operator(const NarrowBand& band, std::span<const float> decoded, std::uint32_t b, const OperatorSetup& setup,
+                    Scratch& s, OperatorOutput& out, OperatorStats& stats) {
   OperatorSeconds& out_seconds = stats.seconds;
   const auto t_start = Clock::now();
   const EvolutionOptions& o = setup.options;
@@ -274,7 +283,7 @@ void brick_operator(const NarrowBand& band, std::uint32_t b, const OperatorSetup
   const bool advection_only = velocity && !advective && o.hamiltonian == Hamiltonian::Godunov;
   const double h = band.voxel_size();
   const Neighborhood around = brick_neighborhood(band, b);
-  gather_box(band, around, kLo, kHi, s.tile, s.rows);
+  gather_box(band, decoded, around, kLo, kHi, s.tile, s.rows);
   stencil_rows(s);
   if (upwind) {
     if (!s.lines) s.lines = std::make_unique<AxisLines>();
@@ -380,18 +389,9 @@ void brick_operator(const NarrowBand& band, std::uint32_t b, const OperatorSetup
       s.k1[std::size_t(i)] = float(c.k1);
       s.k2[std::size_t(i)] = float(c.k2);
     }
-  } else if (needs & kNeedsGauss) {
-    for (int i = 0; i < count; ++i) {
-      const int at = s.curvature_at_tile[std::size_t(i)];
-      const MeanGauss c = at >= 0 ? mean_gauss_curvature_at(s.tile.data() + at, kStride, h) : MeanGauss{};
-      s.mean[std::size_t(i)] = float(c.mean);
-      s.gauss[std::size_t(i)] = float(c.gauss);
-    }
-  } else if (needs & kNeedsMean) {
-    for (int i = 0; i < count; ++i) {
-      const int at = s.curvature_at_tile[std::size_t(i)];
-      s.mean[std::size_t(i)] = at >= 0 ? float(mean_curvature_at(s.tile.data() + at, kStride, h)) : 0.0f;
-    }
+  } else if (needs & (kNeedsGauss | kNeedsMean)) {
+    mean_gauss_curvature_batch(s.tile.data(), s.curvature_at_tile.data(), count, kStride, h, s.mean.data(),
+                               s.gauss.data());
   }
   const auto t_speed = Clock::now();
   out_seconds.curvature += std::chrono::duration<double>(t_speed - t_curvature).count();
@@ -532,12 +532,13 @@ OperatorOutput run_operator(const NarrowBand& band, const OperatorSetup& setup) 
   }
   tbb::combinable<OperatorStats> stats;
   tbb::enumerable_thread_specific<Scratch> scratch;
+  const std::vector<float> decoded = decode_bricks(band);
   tbb::parallel_for(tbb::blocked_range<std::uint32_t>(0, std::uint32_t(band.brick_count()), 8),
                     [&](const tbb::blocked_range<std::uint32_t>& r) {
     Scratch& s = scratch.local();
     OperatorStats& st = stats.local();
     for (std::uint32_t b = r.begin(); b != r.end(); ++b)
-      brick_operator(band, b, setup, s, out, st);
+      brick_operator(band, decoded, b, setup, s, out, st);
   });
   stats.combine_each([&](const OperatorStats& st) {
     out.max_hyperbolic = std::max(out.max_hyperbolic, st.max_hyp);

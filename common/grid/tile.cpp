@@ -4,6 +4,9 @@
 #include <array>
 #include <bit>
 #include <cstring>
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
 #include <string>
 
 #include "core/error.hpp"
@@ -84,8 +87,24 @@ void gather_box(const NarrowBand& band, std::uint32_t brick, int lo, int hi, std
   gather_box(band, brick_neighborhood(band, brick), lo, hi, out, active_rows);
 }
 
-void gather_box(const NarrowBand& band, const Neighborhood& around, int lo, int hi, std::span<float> out,
-                std::span<std::uint32_t> active_rows) {
+namespace {
+
+// Copies `width` floats (8: two vector moves, no memmove call for so short a run).
+inline void copy_row(const float* src, float* dst, int width) {
+  if (width == kBrickDim) {
+    std::array<float, kBrickDim> row;
+    std::memcpy(row.data(), src, sizeof row);
+    std::memcpy(dst, row.data(), sizeof row);
+  } else {
+    for (int x = 0; x < width; ++x) dst[x] = src[x];
+  }
+}
+
+// The box of gather_box, its unallocated neighbours filled here; fill_row(nb, y, z, nlo, nhi,
+// dst) writes local x in [nlo, nhi) of row (y, z) of allocated neighbour nb to dst[x].
+template <typename FillRow>
+void gather_box_rows(const NarrowBand& band, const Neighborhood& around, int lo, int hi, std::span<float> out,
+                     std::span<std::uint32_t> active_rows, FillRow&& fill_row) {
   const std::uint32_t brick = around[std::size_t(Neighborhood::slot(0, 0, 0))];
   if (lo < -kBrickDim || lo > 0 || hi < kBrickDim || hi > 2 * kBrickDim)
     throw Error(ErrorCode::InvalidArgument, "gather_box", "need -8 <= lo <= 0 and 8 <= hi <= 16");
@@ -97,9 +116,7 @@ void gather_box(const NarrowBand& band, const Neighborhood& around, int lo, int 
     throw Error(ErrorCode::InvalidArgument, "gather_box", "active_rows size must be (hi - lo)^2");
   if (rows) std::fill(active_rows.begin(), active_rows.end(), 0u);
   const float bg = band.background();
-  const float sign_value[2] = {bg, -bg};  // by inside bit
   const Coord self = band.bricks()[brick].coord;
-  const float* all_values = band.values().data();
   // Box index of local voxel (x, y, z).
   auto index = [&](int x, int y, int z) {
     return std::size_t(x - lo) + dim * (std::size_t(y - lo) + dim * std::size_t(z - lo));
@@ -133,55 +150,83 @@ void gather_box(const NarrowBand& band, const Neighborhood& around, int lo, int 
               std::fill_n(&out[index(nlo[0] + dx * kBrickDim, y + dy * kBrickDim, z + dz * kBrickDim)], width, v);
           continue;
         }
-        // Row by row: a row of a brick is one byte of its masks, and its active values are
-        // contiguous in the packed storage.
         const Brick& br = band.bricks()[nb];
-        const float* vals = all_values + br.value_offset;
         const std::uint32_t xmask = ((1u << nhi[0]) - 1u) & ~((1u << nlo[0]) - 1u);
         const int shift = nlo[0] + dx * kBrickDim - lo;  // box bit of local x = nlo[0]
         for (int z = nlo[2]; z < nhi[2]; ++z) {
           const std::uint64_t act_word = br.active.words[std::size_t(z)];
-          const std::uint64_t ins_word = band.stored_inside_word(br, z);
-          const int rank_z = br.rank_base(z);
           for (int y = nlo[1]; y < nhi[1]; ++y) {
-            const int bit0 = 8 * y;
-            const std::uint32_t act = std::uint32_t(act_word >> bit0) & 0xffu;
-            const std::uint32_t ins = std::uint32_t(ins_word >> bit0) & 0xffu;
             const std::size_t row = index(lo, y + dy * kBrickDim, z + dz * kBrickDim);
             // Box index of local x: row + (x + dx * kBrickDim - lo), the last term >= 0. Alone,
             // dx * kBrickDim - lo is negative for dx = -1, so no pointer is formed from it
             // (UBSan: pointer overflow); the unsigned sum wraps back exactly.
             const std::size_t base = row - std::size_t(lo - dx * kBrickDim);
-            // Otherwise branch-free per voxel: the value's address is selected, not branched on
-            // (the active pattern of a partial row is unpredictable).
-            const float* row_values = vals + rank_z + std::popcount(act_word & ((std::uint64_t{1} << bit0) - 1));
-            const std::uint32_t before = kActiveBefore[act];
-            if ((act & xmask) == xmask) {
-              // Every voxel of the range active (most rows of a wide band): one contiguous copy.
-              const float* src = row_values + ((before >> (4 * nlo[0])) & 15u);
-              float* dst = &out[base + std::size_t(nlo[0])];
-              if (width == kBrickDim) {
-                std::array<float, kBrickDim> row;  // fixed size: two vector moves, no memmove call
-                std::memcpy(row.data(), src, sizeof row);
-                std::memcpy(dst, row.data(), sizeof row);
-              } else {
-                for (int x = 0; x < width; ++x) dst[x] = src[x];
-              }
-            } else {
-              for (int x = nlo[0]; x < nhi[0]; ++x) {
-                const float* src =
-                    ((act >> x) & 1u) ? row_values + ((before >> (4 * x)) & 15u) : &sign_value[(ins >> x) & 1u];
-                out[base + std::size_t(x)] = *src;
-              }
-            }
-            if (rows)
+            fill_row(nb, br, z, y, nlo[0], nhi[0], width, out.data() + base);
+            if (rows) {
+              const std::uint32_t act = std::uint32_t(act_word >> (8 * y)) & 0xffu;
               active_rows[std::size_t(y + dy * kBrickDim - lo) + dim * std::size_t(z + dz * kBrickDim - lo)] |=
                   ((act & xmask) >> nlo[0]) << shift;
+            }
           }
         }
       }
     }
   }
+}
+
+}  // namespace
+
+void gather_box(const NarrowBand& band, const Neighborhood& around, int lo, int hi, std::span<float> out,
+                std::span<std::uint32_t> active_rows) {
+  const float bg = band.background();
+  const float sign_value[2] = {bg, -bg};  // by inside bit
+  const float* all_values = band.values().data();
+  // A row of a brick is one byte of its masks, and its active values are contiguous in the
+  // packed storage.
+  gather_box_rows(band, around, lo, hi, out, active_rows,
+                  [&](std::uint32_t, const Brick& br, int z, int y, int x0, int x1, int width, float* dst) {
+    const std::uint64_t act_word = br.active.words[std::size_t(z)];
+    const int bit0 = 8 * y;
+    const std::uint32_t act = std::uint32_t(act_word >> bit0) & 0xffu;
+    const std::uint32_t xmask = ((1u << x1) - 1u) & ~((1u << x0) - 1u);
+    const float* row_values = all_values + br.value_offset + br.rank_base(z) +
+                              std::popcount(act_word & ((std::uint64_t{1} << bit0) - 1));
+    const std::uint32_t before = kActiveBefore[act];
+    if ((act & xmask) == xmask) {
+      // Every voxel of the range active (most rows of a wide band): one contiguous copy.
+      copy_row(row_values + ((before >> (4 * x0)) & 15u), dst + x0, width);
+      return;
+    }
+    // Otherwise branch-free per voxel: the value's address is selected, not branched on (the
+    // active pattern of a partial row is unpredictable).
+    const std::uint32_t ins = std::uint32_t(band.stored_inside_word(br, z) >> bit0) & 0xffu;
+    for (int x = x0; x < x1; ++x) {
+      const float* src = ((act >> x) & 1u) ? row_values + ((before >> (4 * x)) & 15u) : &sign_value[(ins >> x) & 1u];
+      dst[x] = *src;
+    }
+  });
+}
+
+std::vector<float> decode_bricks(const NarrowBand& band) {
+  std::vector<float> decoded(band.brick_count() * std::size_t(kBrickVoxels));
+  tbb::parallel_for(tbb::blocked_range<std::uint32_t>(0, std::uint32_t(band.brick_count()), 64),
+                    [&](const tbb::blocked_range<std::uint32_t>& r) {
+                      for (std::uint32_t b = r.begin(); b != r.end(); ++b)
+                        decode_brick(band, b,
+                                     std::span<float, kBrickVoxels>(decoded.data() + std::size_t(b) * kBrickVoxels,
+                                                                    kBrickVoxels));
+                    });
+  return decoded;
+}
+
+void gather_box(const NarrowBand& band, std::span<const float> decoded, const Neighborhood& around, int lo, int hi,
+                std::span<float> out, std::span<std::uint32_t> active_rows) {
+  if (decoded.size() != band.brick_count() * std::size_t(kBrickVoxels))
+    throw Error(ErrorCode::InvalidArgument, "gather_box", "decoded bricks do not match the band");
+  gather_box_rows(band, around, lo, hi, out, active_rows,
+                  [&](std::uint32_t nb, const Brick&, int z, int y, int x0, int, int width, float* dst) {
+    copy_row(decoded.data() + std::size_t(nb) * kBrickVoxels + std::size_t(local_index(x0, y, z)), dst + x0, width);
+  });
 }
 
 void scatter_active(NarrowBand& band, std::uint32_t brick, int halo, std::span<const float> tile) {

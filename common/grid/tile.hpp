@@ -57,6 +57,15 @@ void gather_box(const NarrowBand& band, const Neighborhood& around, int lo, int 
 // Dense 512 values of one brick (halo 0) into out[local_index].
 void decode_brick(const NarrowBand& band, std::uint32_t brick, std::span<float, kBrickVoxels> out);
 
+// Every brick decoded once (decode_brick; 512 values per brick, in brick order; TBB), for a
+// pass that gathers a box around every brick: a box then copies rows from the decoded bricks
+// instead of decoding each neighbour again (a 14^3 box decodes 5.4 bricks' worth of voxels).
+// Memory: 2 KiB per brick.
+std::vector<float> decode_bricks(const NarrowBand& band);
+// gather_box from decode_bricks(band): the same output, by row copies.
+void gather_box(const NarrowBand& band, std::span<const float> decoded, const Neighborhood& around, int lo, int hi,
+                std::span<float> out, std::span<std::uint32_t> active_rows);
+
 // Writes tile values back to the active voxels of the brick (inactive voxels untouched,
 // signs of active voxels updated). tile is laid out with the given halo.
 void scatter_active(NarrowBand& band, std::uint32_t brick, int halo, std::span<const float> tile);

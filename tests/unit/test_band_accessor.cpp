@@ -91,12 +91,18 @@ TEST_P(TileTest, GatherMatchesAccessorIncludingHalo) {
   const TileShape shape{halo};
   std::vector<float> tile(shape.size()), tile2(shape.size());
   const std::size_t dim = std::size_t(shape.dim());
-  std::vector<std::uint32_t> rows(dim * dim);
+  std::vector<std::uint32_t> rows(dim * dim), rows3(dim * dim);
+  std::vector<float> tile3(shape.size());
+  const std::vector<float> decoded = decode_bricks(band);
   BandAccessor acc(band);
   for (std::uint32_t b = 0; b < band.brick_count(); ++b) {
     gather_tile(band, b, halo, tile);
     gather_tile(band, b, halo, tile2, rows);
     ASSERT_EQ(tile, tile2);
+    // From the decoded bricks: the same box and active rows.
+    gather_box(band, decoded, brick_neighborhood(band, b), -halo, kBrickDim + halo, tile3, rows3);
+    ASSERT_EQ(tile, tile3) << "brick " << b;
+    ASSERT_EQ(rows, rows3) << "brick " << b;
     const Coord o = brick_origin(band.bricks()[b].coord);
     for (int z = -halo; z < kBrickDim + halo; ++z)
       for (int y = -halo; y < kBrickDim + halo; ++y)
@@ -110,6 +116,9 @@ TEST_P(TileTest, GatherMatchesAccessorIncludingHalo) {
   }
   std::vector<std::uint32_t> wrong(dim * dim + 1);
   EXPECT_THROW(gather_tile(band, 0, halo, tile, wrong), Error);
+  EXPECT_THROW(gather_box(band, std::span<const float>(decoded).first(kBrickVoxels), brick_neighborhood(band, 0), -halo,
+                          kBrickDim + halo, tile3, rows3),
+               Error);
 }
 
 INSTANTIATE_TEST_SUITE_P(Halos, TileTest, ::testing::Values(0, 1, 2, 3, 8));

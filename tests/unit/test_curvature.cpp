@@ -1,6 +1,7 @@
 // Curvature from dense samples (evolve/curvature.hpp) against analytic answers: sphere,
 // cylinder, plane, torus, saddle, convergence order, degenerate gradient, and the agreement of
-// mean_curvature_at with curvature_at().mean, and mean_gauss_curvature_at with its mean and gauss.
+// mean_curvature_at with curvature_at().mean, and mean_gauss_curvature_at with its mean and gauss;
+// the batched form (curvature_batch.hpp) against the single one, bit for bit.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -12,6 +13,7 @@
 
 #include "core/vec3.hpp"
 #include "evolve/curvature.hpp"
+#include "evolve/curvature_batch.hpp"
 
 namespace levelset::evolve {
 namespace {
@@ -337,6 +339,37 @@ TEST(Curvature, DegenerateGradientGivesZeros) {
             0.5 * std::sqrt(double((i - 1) * (i - 1) + (j - 1) * (j - 1) + (k - 1) * (k - 1))) -
             1.0);
   expect_zero(centre);
+}
+
+// The batch form gives mean_gauss_curvature_at's values as floats, bit for bit, for every
+// centre of a field with curvature of both signs, saddles, a flat region (zero gradient: 0)
+// and centres without a stencil (-1: 0), over several chunks of 64.
+TEST(Curvature, BatchEqualsSingleBitForBit) {
+  const int n = 12;
+  const double h = 0.3;
+  const DenseGrid g(
+      [](const Vec3d& p) {
+        if (p.x > 1.0) return 0.25;  // flat: zero gradient
+        return std::sin(1.3 * p.x) * std::cos(0.7 * p.y) + 0.4 * p.z * p.z - 0.2 * p.x * p.y + 0.1 * p.y * p.z;
+      },
+      Vec3d{-1.0, -1.2, -0.9}, h, n);
+  std::vector<int> at;
+  for (int k = 1; k < n - 1; ++k)
+    for (int j = 1; j < n - 1; ++j)
+      for (int i = 1; i < n - 1; ++i) at.push_back((i + j + k) % 17 == 0 ? -1 : int(g.index(i, j, k)));
+  ASSERT_GT(at.size(), 3u * 64u);
+  std::vector<float> mean(at.size(), -7.0f), gauss(at.size(), -7.0f);
+  mean_gauss_curvature_batch(g.values.data(), at.data(), int(at.size()), g.stride, h, mean.data(), gauss.data());
+  int flat = 0, none = 0;
+  for (std::size_t i = 0; i < at.size(); ++i) {
+    const MeanGauss single = at[i] >= 0 ? mean_gauss_curvature_at(g.values.data() + at[i], g.stride, h) : MeanGauss{};
+    EXPECT_EQ(mean[i], float(single.mean)) << "centre " << i;
+    EXPECT_EQ(gauss[i], float(single.gauss)) << "centre " << i;
+    none += at[i] < 0;
+    flat += at[i] >= 0 && single.mean == 0.0 && single.gauss == 0.0;
+  }
+  EXPECT_GT(none, 0);
+  EXPECT_GT(flat, 0);
 }
 
 }  // namespace
