@@ -4,13 +4,12 @@
 #include <array>
 #include <cmath>
 
+#include "core/error.hpp"
 #include "evolve/curvature.hpp"
 
 namespace levelset::evolve {
 
 namespace {
-
-constexpr int kChunk = 64;
 
 // The 19 stencil samples: centre, x-, x+, y-, y+, z-, z+, then the cross terms' corners in
 // the order central_derivs reads them (xy, xz, yz; each ++, +-, -+, --).
@@ -22,11 +21,11 @@ std::array<std::ptrdiff_t, kSamples> sample_offsets(const std::ptrdiff_t stride[
           -sx - sy, sx + sz, sx - sz, -sx + sz, -sx - sz, sy + sz, sy - sz, -sy + sz, -sy - sz};
 }
 
-// One chunk: s[k][i] holds sample k of centre i; valid[i] says whether it has a centre.
-void chunk_curvature(const double (&s)[kSamples][kChunk], const double* valid, int n, double h, double* mean,
-                     double* gauss) {
+// Eight consecutive centres: s[k][x] holds sample k of centre x.
+void row_curvature(const double (&s)[kSamples][kBrickDim], double h, double (&mean)[kBrickDim],
+                   double (&gauss)[kBrickDim]) {
   const double inv2h = 0.5 / h, invh2 = 1.0 / (h * h), inv4h2 = 0.25 * invh2;
-  for (int i = 0; i < n; ++i) {
+  for (int i = 0; i < kBrickDim; ++i) {
     const double c = s[C][i];
     const double xp = s[XP][i], xm = s[XM][i], yp = s[YP][i], ym = s[YM][i], zp = s[ZP][i], zm = s[ZM][i];
     const double gx = (xp - xm) * inv2h, gy = (yp - ym) * inv2h, gz = (zp - zm) * inv2h;
@@ -42,7 +41,7 @@ void chunk_curvature(const double (&s)[kSamples][kChunk], const double* valid, i
     const double axx = yy * zz - yz * yz, ayy = xx * zz - xz * xz, azz = xx * yy - xy * xy;
     const double axy = xz * yz - xy * zz, axz = xy * yz - xz * yy, ayz = xy * xz - xx * yz;
     const double gag = axx * gx * gx + ayy * gy * gy + azz * gz * gz + 2.0 * (axy * gx * gy + axz * gx * gz + ayz * gy * gz);
-    const bool ok = valid[i] != 0.0 && gn > kMinGradNorm;  // also false for NaN
+    const bool ok = gn > kMinGradNorm;  // also false for NaN
     const double m = (g2 * trace - ghg) / (g2 * gn), k = gag / (g2 * g2);
     mean[i] = ok ? m : 0.0;
     gauss[i] = ok ? k : 0.0;
@@ -51,28 +50,41 @@ void chunk_curvature(const double (&s)[kSamples][kChunk], const double* valid, i
 
 }  // namespace
 
-void mean_gauss_curvature_batch(const float* tile, const int* at, int count, const std::ptrdiff_t stride[3], double h,
-                                float* mean, float* gauss) {
+void mean_gauss_curvature_brick(const float* tile, std::ptrdiff_t origin, const std::ptrdiff_t stride[3],
+                                const BrickMask& active, const int* at, double h, float* mean, float* gauss) {
+  if (stride[0] != 1) throw Error(ErrorCode::InvalidArgument, "mean_gauss_curvature_brick", "x must be the tile's fastest axis");
   const std::array<std::ptrdiff_t, kSamples> offset = sample_offsets(stride);
-  double s[kSamples][kChunk], valid[kChunk], m[kChunk], k[kChunk];
-  for (int first = 0; first < count; first += kChunk) {
-    const int n = std::min(kChunk, count - first);
-    for (int i = 0; i < n; ++i) {
-      const int a = at[first + i];
-      valid[i] = a >= 0 ? 1.0 : 0.0;
-      if (a < 0) {
-        for (int j = 0; j < kSamples; ++j) s[j][i] = 0.0;
-        continue;
+  double s[kSamples][kBrickDim], m[kBrickDim], g[kBrickDim];
+  int k = 0;
+  for (int z = 0; z < kBrickDim; ++z)
+    for (int y = 0; y < kBrickDim; ++y) {
+      const std::uint32_t row = std::uint32_t(active.words[std::size_t(z)] >> (8 * y)) & 0xffu;
+      if (row == 0) continue;
+      const std::ptrdiff_t first = origin + y * stride[1] + z * stride[2];
+      bool own = false;  // some voxel of the row takes its own curvature
+      for (int i = 0, x = 0; x < kBrickDim; ++x)
+        if ((row >> x) & 1u) own |= at[k + i++] == first + x;
+      if (own) {
+        for (int j = 0; j < kSamples; ++j) {
+          const float* v = tile + first + offset[std::size_t(j)];
+          for (int x = 0; x < kBrickDim; ++x) s[j][x] = v[x];  // stride[0] == 1
+        }
+        row_curvature(s, h, m, g);
       }
-      const float* v = tile + a;
-      for (int j = 0; j < kSamples; ++j) s[j][i] = v[offset[std::size_t(j)]];
+      for (int x = 0; x < kBrickDim; ++x) {
+        if (!((row >> x) & 1u)) continue;
+        const int a = at[k];
+        if (a == first + x) {
+          mean[k] = float(m[x]);
+          gauss[k] = float(g[x]);
+        } else {
+          const MeanGauss c = a >= 0 ? mean_gauss_curvature_at(tile + a, stride, h) : MeanGauss{};
+          mean[k] = float(c.mean);
+          gauss[k] = float(c.gauss);
+        }
+        ++k;
+      }
     }
-    chunk_curvature(s, valid, n, h, m, k);
-    for (int i = 0; i < n; ++i) {
-      mean[first + i] = float(m[i]);
-      gauss[first + i] = float(k[i]);
-    }
-  }
 }
 
 }  // namespace levelset::evolve

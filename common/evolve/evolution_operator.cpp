@@ -390,8 +390,8 @@ void brick_operator(const NarrowBand& band, std::span<const float> decoded, std:
       s.k2[std::size_t(i)] = float(c.k2);
     }
   } else if (needs & (kNeedsGauss | kNeedsMean)) {
-    mean_gauss_curvature_batch(s.tile.data(), s.curvature_at_tile.data(), count, kStride, h, s.mean.data(),
-                               s.gauss.data());
+    mean_gauss_curvature_brick(s.tile.data(), tile_index(0, 0, 0), kStride, br.active, s.curvature_at_tile.data(), h,
+                               s.mean.data(), s.gauss.data());
   }
   const auto t_speed = Clock::now();
   out_seconds.curvature += std::chrono::duration<double>(t_speed - t_curvature).count();

@@ -1,7 +1,7 @@
 // Curvature from dense samples (evolve/curvature.hpp) against analytic answers: sphere,
 // cylinder, plane, torus, saddle, convergence order, degenerate gradient, and the agreement of
 // mean_curvature_at with curvature_at().mean, and mean_gauss_curvature_at with its mean and gauss;
-// the batched form (curvature_batch.hpp) against the single one, bit for bit.
+// the brick form (curvature_batch.hpp) against the single one, bit for bit.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -11,6 +11,7 @@
 #include <functional>
 #include <vector>
 
+#include "core/error.hpp"
 #include "core/vec3.hpp"
 #include "evolve/curvature.hpp"
 #include "evolve/curvature_batch.hpp"
@@ -341,11 +342,12 @@ TEST(Curvature, DegenerateGradientGivesZeros) {
   expect_zero(centre);
 }
 
-// The batch form gives mean_gauss_curvature_at's values as floats, bit for bit, for every
-// centre of a field with curvature of both signs, saddles, a flat region (zero gradient: 0)
-// and centres without a stencil (-1: 0), over several chunks of 64.
-TEST(Curvature, BatchEqualsSingleBitForBit) {
-  const int n = 12;
+// The brick form gives mean_gauss_curvature_at's values as floats, bit for bit, for every
+// active voxel of a brick: rows that take their own curvature (curvature of both signs,
+// saddles, a flat region with zero gradient: 0), voxels taking a neighbour's centre, and
+// voxels without one (-1: 0).
+TEST(Curvature, BrickFormEqualsSingleBitForBit) {
+  const int n = 12;  // the brick at grid 2..9, its stencils within 1..10
   const double h = 0.3;
   const DenseGrid g(
       [](const Vec3d& p) {
@@ -353,23 +355,44 @@ TEST(Curvature, BatchEqualsSingleBitForBit) {
         return std::sin(1.3 * p.x) * std::cos(0.7 * p.y) + 0.4 * p.z * p.z - 0.2 * p.x * p.y + 0.1 * p.y * p.z;
       },
       Vec3d{-1.0, -1.2, -0.9}, h, n);
+  BrickMask active;
   std::vector<int> at;
-  for (int k = 1; k < n - 1; ++k)
-    for (int j = 1; j < n - 1; ++j)
-      for (int i = 1; i < n - 1; ++i) at.push_back((i + j + k) % 17 == 0 ? -1 : int(g.index(i, j, k)));
-  ASSERT_GT(at.size(), 3u * 64u);
+  int own = 0, other = 0, none = 0;
+  for (int z = 0; z < 8; ++z)
+    for (int y = 0; y < 8; ++y)
+      for (int x = 0; x < 8; ++x) {
+        const int pattern = (3 * x + 5 * y + 7 * z) % 11;
+        if (pattern == 0) continue;  // inactive
+        active.set(x + 8 * (y + 8 * z));
+        const int self = int(g.index(x + 2, y + 2, z + 2));
+        if (pattern == 1) {
+          at.push_back(-1);
+          ++none;
+        } else if (pattern == 2) {
+          at.push_back(int(g.index(x + 2, y + 2, z + (z < 4 ? 3 : 1))));  // a neighbour along z
+          ++other;
+        } else {
+          at.push_back(self);
+          ++own;
+        }
+      }
+  ASSERT_GT(own, 0);
+  ASSERT_GT(other, 0);
+  ASSERT_GT(none, 0);
   std::vector<float> mean(at.size(), -7.0f), gauss(at.size(), -7.0f);
-  mean_gauss_curvature_batch(g.values.data(), at.data(), int(at.size()), g.stride, h, mean.data(), gauss.data());
-  int flat = 0, none = 0;
+  mean_gauss_curvature_brick(g.values.data(), std::ptrdiff_t(g.index(2, 2, 2)), g.stride, active, at.data(), h,
+                             mean.data(), gauss.data());
+  int flat = 0;
   for (std::size_t i = 0; i < at.size(); ++i) {
     const MeanGauss single = at[i] >= 0 ? mean_gauss_curvature_at(g.values.data() + at[i], g.stride, h) : MeanGauss{};
-    EXPECT_EQ(mean[i], float(single.mean)) << "centre " << i;
-    EXPECT_EQ(gauss[i], float(single.gauss)) << "centre " << i;
-    none += at[i] < 0;
+    EXPECT_EQ(mean[i], float(single.mean)) << "voxel " << i;
+    EXPECT_EQ(gauss[i], float(single.gauss)) << "voxel " << i;
     flat += at[i] >= 0 && single.mean == 0.0 && single.gauss == 0.0;
   }
-  EXPECT_GT(none, 0);
   EXPECT_GT(flat, 0);
+  const std::ptrdiff_t strided[3] = {2, 24, 288};
+  EXPECT_THROW(mean_gauss_curvature_brick(g.values.data(), 0, strided, active, at.data(), h, mean.data(), gauss.data()),
+               Error);
 }
 
 }  // namespace
