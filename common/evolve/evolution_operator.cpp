@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <array>
+#include <bit>
 #include <chrono>
 #include <cmath>
 #include <limits>
@@ -292,6 +293,14 @@ void brick_operator(const NarrowBand& band, std::span<const float> decoded, std:
   const Brick& br = band.bricks()[b];
   const Coord origin = brick_origin(br.coord);
   const std::size_t first = br.value_offset;
+  if (setup.want_edges) {
+    // One allocation for the brick's edge stencils (at most one per edge voxel).
+    int edges = 0;
+    for (int r = 0; r < kBrickDim * kBrickDim; ++r)
+      edges += std::popcount(unsigned(std::uint8_t(br.active.words[std::size_t(r >> 3)] >> (8 * (r & 7)))) &
+                             ~unsigned(s.interior[std::size_t(r)]) & 0xffu);
+    out.edge_stencils[b].reserve(std::size_t(edges));
+  }
   int k = 0;
   br.active.for_each_set([&](int n) {
     const Coord l = local_coord(n);
