@@ -192,9 +192,13 @@ void sweep_second(float* tile, const BrickMask& order_mask, int x, float toleran
 }
 
 // Up to 8 ordered sweeps of one brick (fewer once no voxel is dirty) on a tile with the
-// face neighbours' current values. `dirty` persists between iterations.
+// face neighbours' current values, starting with the pair `first` and its opposite. `dirty`
+// persists between iterations.
 BrickSweep sweep_brick(RedistanceDomain& w, std::uint32_t b, const BrickMask& free_mask, BrickMask& dirty, bool second,
-                       float tolerance) {
+                       float tolerance, int first) {
+  int order[8] = {first, first ^ 7};
+  for (int k = 0, o = 2; k < 8; ++k)
+    if (kOrderings[k] != first && kOrderings[k] != (first ^ 7)) order[o++] = kOrderings[k];
   BrickSweep s;
   float* own = w.values(b);
   auto pending = [&] {
@@ -206,7 +210,7 @@ BrickSweep sweep_brick(RedistanceDomain& w, std::uint32_t b, const BrickMask& fr
     alignas(64) float tile[TileGeom<1>::kVoxels];
     load_tile<1, false>(w, b, tile);
     for (int k = 0; k < 8 && pending(); ++k) {
-      const int flip = kOrderings[k];
+      const int flip = order[k];
       sweep_first(tile, permute(free_mask, flip), flip_xor(flip), dirty, s);
     }
     free_mask.for_each_set([&](int n) { own[n] = tile[kGeom1.tile_of[n]]; });
@@ -214,12 +218,41 @@ BrickSweep sweep_brick(RedistanceDomain& w, std::uint32_t b, const BrickMask& fr
     alignas(64) float tile[TileGeom<2>::kVoxels];
     load_tile<2, true>(w, b, tile);
     for (int k = 0; k < 8 && pending(); ++k) {
-      const int flip = kOrderings[k];
+      const int flip = order[k];
       sweep_second(tile, permute(free_mask, flip), flip_xor(flip), tolerance, dirty, s);
     }
     free_mask.for_each_set([&](int n) { own[n] = std::abs(tile[kGeom2.tile_of[n]]); });
   }
   return s;
+}
+
+// Per brick, the ordering to sweep first: along increasing distance from the interface
+// voxels, judged from their centroid against the brick's centre (from the face neighbours
+// holding interface voxels when the brick holds none). Information then crosses the brick in
+// its first sweep; with a fixed first ordering, bricks whose characteristics run the other
+// way took every ordering, each re-marking the voxels it changed (Table 5.1's sphere at
+// N = 256, W = 6: 8.6 -> 5.0 evaluations per voxel). The pair's opposite, swept second,
+// serves the other side of the zero level. Only the order of the sweeps changes.
+std::vector<std::uint8_t> first_orderings(const RedistanceDomain& w) {
+  std::vector<std::uint8_t> first(w.size(), 0);
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, w.size(), 256), [&](const tbb::blocked_range<std::size_t>& r) {
+    for (std::size_t b = r.begin(); b != r.end(); ++b) {
+      int c[3] = {0, 0, 0};  // twice the centroid offset, summed
+      w.fixed[b].for_each_set([&](int v) {
+        for (int a = 0; a < 3; ++a) c[a] += 2 * ((v >> (3 * a)) & 7) - (kBrickDim - 1);
+      });
+      if (w.fixed[b].none())
+        for (int f = 0; f < 6; ++f) {
+          const std::uint32_t nb = w.nbr[b][std::size_t(f)];
+          if (nb != kNoBrick && !w.fixed[nb].none()) c[f >> 1] += (f & 1) ? 1 : -1;
+        }
+      int flip = 0;  // bit a: sweep axis a downward (the interface lies above the centre)
+      for (int a = 0; a < 3; ++a)
+        if (c[a] > 0) flip |= 1 << a;
+      first[b] = std::uint8_t(flip);
+    }
+  });
+  return first;
 }
 
 }  // namespace
@@ -239,6 +272,7 @@ int sweep(RedistanceDomain& w, int order, int max_iterations, float tolerance, c
     const Coord c = w.coords[b];
     colour[(c.x + c.y + c.z) & 1].push_back(b);
   }
+  const std::vector<std::uint8_t> first = first_orderings(w);
   BrickMask layers[6];
   for (int f = 0; f < 6; ++f) layers[f] = face_layer(f, reach);
   // Per brick: bit f = the neighbour across face f changed its layer there; bit 6 = own work.
@@ -261,7 +295,7 @@ int sweep(RedistanceDomain& w, int order, int max_iterations, float tolerance, c
           for (int f = 0; f < 6; ++f)
             if (bits >> f & 1)
               for (int k = 0; k < 8; ++k) dirty[b].words[k] |= layers[f].words[k];
-          const BrickSweep s = sweep_brick(w, b, free_mask[b], dirty[b], second, tolerance);
+          const BrickSweep s = sweep_brick(w, b, free_mask[b], dirty[b], second, tolerance, first[b]);
           change[b] = s.max_change;
           if (!dirty[b].none()) flags[b].fetch_or(kOwnWork, std::memory_order_relaxed);
           for (int f = 0; f < 6; ++f) {
