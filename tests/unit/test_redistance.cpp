@@ -594,6 +594,26 @@ TEST(TrialQueue, PushAfterAnEmptyPeekIsPopped) {
   EXPECT_EQ(e.id, 11u);
 }
 
+// A slice is sorted once it becomes current; values pushed into it afterwards (within 1/256
+// voxel of the one just accepted) still come out in order, merged with the sorted rest, and
+// equal values in id order.
+TEST(TrialQueue, PushesIntoTheCurrentSliceMergeInOrder) {
+  detail::TrialQueue q(4.0);
+  q.push({1.0f, 5});
+  q.push({1.003f, 6});
+  q.push({1.003f, 2});
+  q.push({2.5f, 7});
+  detail::HeapEntry e;
+  ASSERT_TRUE(q.pop(e));
+  EXPECT_EQ(e.id, 5u);
+  q.push({1.001f, 9});   // the current slice, after its sort
+  q.push({1.003f, 1});   // ties with two sorted entries: smallest id first
+  q.push({0.999f, 3});   // below the last pop (rounding): still the minimum now
+  std::vector<std::uint32_t> order;
+  while (q.pop(e)) order.push_back(e.id);
+  EXPECT_EQ(order, (std::vector<std::uint32_t>{3, 9, 1, 2, 6, 7}));
+}
+
 TEST(TrialQueue, PopsInValueOrderAcrossSlices) {
   detail::TrialQueue q(6.0);
   std::vector<float> values;
