@@ -541,13 +541,13 @@ OperatorOutput run_operator(const NarrowBand& band, const OperatorSetup& setup) 
   }
   tbb::combinable<OperatorStats> stats;
   tbb::enumerable_thread_specific<Scratch> scratch;
-  const std::vector<float> decoded = decode_bricks(band);
+  const DecodedBricks decoded = decode_bricks(band);
   tbb::parallel_for(tbb::blocked_range<std::uint32_t>(0, std::uint32_t(band.brick_count()), 8),
                     [&](const tbb::blocked_range<std::uint32_t>& r) {
     Scratch& s = scratch.local();
     OperatorStats& st = stats.local();
     for (std::uint32_t b = r.begin(); b != r.end(); ++b)
-      brick_operator(band, decoded, b, setup, s, out, st);
+      brick_operator(band, decoded.values(), b, setup, s, out, st);
   });
   stats.combine_each([&](const OperatorStats& st) {
     out.max_hyperbolic = std::max(out.max_hyperbolic, st.max_hyp);

@@ -10,6 +10,7 @@
 #include <string>
 
 #include "core/error.hpp"
+#include "core/huge_pages.hpp"
 
 namespace levelset {
 
@@ -207,16 +208,21 @@ void gather_box(const NarrowBand& band, const Neighborhood& around, int lo, int 
   });
 }
 
-std::vector<float> decode_bricks(const NarrowBand& band) {
-  std::vector<float> decoded(band.brick_count() * std::size_t(kBrickVoxels));
+DecodedBricks decode_bricks(const NarrowBand& band) {
+  DecodedBricks out;
+  out.size = band.brick_count() * std::size_t(kBrickVoxels);
+  // Not value-initialised: every entry is written below, in parallel, which is also where
+  // fresh pages fault in (a zeroing pass would touch them all on one thread first).
+  out.data.reset(new float[std::max<std::size_t>(out.size, 1)]);
+  if (out.size * sizeof(float) >= (std::size_t{2} << 21)) advise_huge_pages(out.data.get(), out.size * sizeof(float));
   tbb::parallel_for(tbb::blocked_range<std::uint32_t>(0, std::uint32_t(band.brick_count()), 64),
                     [&](const tbb::blocked_range<std::uint32_t>& r) {
                       for (std::uint32_t b = r.begin(); b != r.end(); ++b)
                         decode_brick(band, b,
-                                     std::span<float, kBrickVoxels>(decoded.data() + std::size_t(b) * kBrickVoxels,
+                                     std::span<float, kBrickVoxels>(out.data.get() + std::size_t(b) * kBrickVoxels,
                                                                     kBrickVoxels));
                     });
-  return decoded;
+  return out;
 }
 
 void gather_box(const NarrowBand& band, std::span<const float> decoded, const Neighborhood& around, int lo, int hi,

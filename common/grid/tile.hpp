@@ -12,6 +12,7 @@
 
 #include <array>
 #include <cstdint>
+#include <memory>
 #include <span>
 #include <vector>
 
@@ -60,8 +61,13 @@ void decode_brick(const NarrowBand& band, std::uint32_t brick, std::span<float, 
 // Every brick decoded once (decode_brick; 512 values per brick, in brick order; TBB), for a
 // pass that gathers a box around every brick: a box then copies rows from the decoded bricks
 // instead of decoding each neighbour again (a 14^3 box decodes 5.4 bricks' worth of voxels).
-// Memory: 2 KiB per brick.
-std::vector<float> decode_bricks(const NarrowBand& band);
+// Memory: 2 KiB per brick (huge pages advised when large).
+struct DecodedBricks {
+  std::unique_ptr<float[]> data;
+  std::size_t size = 0;
+  std::span<const float> values() const { return {data.get(), size}; }
+};
+DecodedBricks decode_bricks(const NarrowBand& band);
 // gather_box from decode_bricks(band): the same output, by row copies.
 void gather_box(const NarrowBand& band, std::span<const float> decoded, const Neighborhood& around, int lo, int hi,
                 std::span<float> out, std::span<std::uint32_t> active_rows);

@@ -13,6 +13,7 @@
 
 #include <array>
 #include <cstdint>
+#include <span>
 #include <vector>
 
 #include "grid/tile.hpp"
@@ -33,6 +34,7 @@ struct CellTile {
   Neighborhood around{};
 };
 
-void gather_cell_tile(const NarrowBand& band, std::uint32_t brick, CellTile& tile);
+// decoded: decode_bricks(band) (the tile is then gathered by row copies) or empty.
+void gather_cell_tile(const NarrowBand& band, std::uint32_t brick, CellTile& tile, std::span<const float> decoded = {});
 
 }  // namespace levelset

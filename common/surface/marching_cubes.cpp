@@ -39,12 +39,12 @@ struct Scratch {
   EdgeCrossings edges;
 };
 
-void process_brick(const NarrowBand& band, std::uint32_t b, double iso, Scratch& scratch,
-                   BrickOut& out) {
+void process_brick(const NarrowBand& band, std::span<const float> decoded, std::uint32_t b, double iso,
+                   Scratch& scratch, BrickOut& out) {
   CellTile& t = scratch.tile;
   const double h = band.voxel_size();
   ValidCells valid;
-  const Vec3d corner = begin_brick(band, b, iso, t, valid, out);
+  const Vec3d corner = begin_brick(band, b, iso, t, valid, out, decoded);
   out.triangles.reserve(2 * valid.mixed_cells + 8);
 
   // Edge crossings of the cells [0, 8)^3, and the vertices of the owned ones in slot order.
@@ -128,8 +128,10 @@ SurfaceResult marching_cubes(const NarrowBand& band, const MarchingCubesOptions&
   std::vector<BrickOut> outs(nb);
   const std::vector<std::uint8_t> work = bricks_with_crossings(band, options.iso);
   tbb::enumerable_thread_specific<Scratch> scratch;
+  // Each brick decoded once (its tile and its neighbours' tiles then copy rows).
+  const DecodedBricks decoded = decode_bricks(band);
   for_brick_batches(nb, options.progress, "marching_cubes", [&](std::uint32_t b) {
-    if (work[b]) process_brick(band, b, options.iso, scratch.local(), outs[b]);
+    if (work[b]) process_brick(band, decoded.values(), b, options.iso, scratch.local(), outs[b]);
   });
 
   SurfaceResult r;

@@ -249,8 +249,9 @@ void check_iso(const NarrowBand& band, double iso, std::string_view where);
 // the output's vertex keys refer to, classifies the tile's rows, reserves the vertex buffers;
 // returns the world position of the brick's voxel (0, 0, 0).
 template <typename Out>
-Vec3d begin_brick(const NarrowBand& band, std::uint32_t b, double iso, CellTile& t, ValidCells& valid, Out& out) {
-  gather_cell_tile(band, b, t);
+Vec3d begin_brick(const NarrowBand& band, std::uint32_t b, double iso, CellTile& t, ValidCells& valid, Out& out,
+                  std::span<const float> decoded = {}) {
+  gather_cell_tile(band, b, t, decoded);
   out.around = t.around;
   valid.compute(t, iso);
   out.vertices.reserve(std::size_t(valid.mixed_cells) + 8);

@@ -93,7 +93,8 @@ TEST_P(TileTest, GatherMatchesAccessorIncludingHalo) {
   const std::size_t dim = std::size_t(shape.dim());
   std::vector<std::uint32_t> rows(dim * dim), rows3(dim * dim);
   std::vector<float> tile3(shape.size());
-  const std::vector<float> decoded = decode_bricks(band);
+  const DecodedBricks decoded_bricks = decode_bricks(band);
+  const std::span<const float> decoded = decoded_bricks.values();
   BandAccessor acc(band);
   for (std::uint32_t b = 0; b < band.brick_count(); ++b) {
     gather_tile(band, b, halo, tile);
