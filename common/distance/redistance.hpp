@@ -34,16 +34,19 @@
 //      values), first order elsewhere (order = 1: first order everywhere).
 //      - Sweep: fast sweeping (Zhao 2005) brick by brick on a dense tile whose halo holds
 //        the face neighbours' values (1 voxel deep, 2 for second order). Each iteration
-//        sweeps every brick with pending work in up to 8 alternating orderings; bricks run
+//        sweeps every brick with pending work in up to 8 alternating orderings, the first
+//        pair chosen per brick along increasing distance from its interface voxels (their
+//        centroid against the brick's centre, else the neighbours'); bricks run
 //        in two checkerboard colours, so bricks sweeping concurrently never share a face,
 //        and a brick is revisited only when a neighbour changed values it reads. Within a
 //        brick only voxels whose stencil changed are re-evaluated (same values, less work).
 //        Stops when an iteration's largest change is < tolerance*h, nothing is pending, or
 //        after max_sweep_iterations.
 //      - March: fast marching (Sethian) from the interface voxels outward, accepting the
-//        smallest tentative value first (binary min-heaps with lazy deletion, one per
-//        1/256-voxel slice of the value range: the same pop order as one heap, but small
-//        heaps), until the smallest tentative distance exceeds W*h.
+//        smallest tentative value first (lazy deletion; one bucket per 1/256-voxel slice of
+//        the value range, sorted once when it becomes current, a small heap for the rare
+//        pushes into the current slice: the same pop order as one heap), until the smallest
+//        tentative distance exceeds W*h.
 //      First order: both give the same discrete solution (up to rounding). Second order:
 //      they differ by < 0.01 h (the march fixes a value when it is accepted).
 // Accuracy (tests/unit/test_redistance.cpp, u distorted by 1 + 0.5 sin sin sin, W = 3):
