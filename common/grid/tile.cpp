@@ -4,10 +4,10 @@
 #include <array>
 #include <bit>
 #include <cstring>
+#include <string>
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
-#include <string>
 
 #include "core/error.hpp"
 #include "core/huge_pages.hpp"
@@ -101,8 +101,9 @@ inline void copy_row(const float* src, float* dst, int width) {
   }
 }
 
-// The box of gather_box, its unallocated neighbours filled here; fill_row(nb, y, z, nlo, nhi,
-// dst) writes local x in [nlo, nhi) of row (y, z) of allocated neighbour nb to dst[x].
+// The box of gather_box, its unallocated neighbours filled here; fill_row(nb, brick, z, y, x0,
+// x1, width, dst) writes local x in [x0, x1) (width = x1 - x0) of row (y, z) of allocated
+// neighbour nb to dst[x].
 template <typename FillRow>
 void gather_box_rows(const NarrowBand& band, const Neighborhood& around, int lo, int hi, std::span<float> out,
                      std::span<std::uint32_t> active_rows, FillRow&& fill_row) {
