@@ -62,33 +62,58 @@ namespace detail {
 inline double eno2_correction(double a, double b) { return std::abs(a) <= std::abs(b) ? a : b; }
 
 // HJ-WENO5 from the five differences v1..v5 (O&F eq. 3.25-3.35); v3 is the difference across
-// the upwind interval, v1 the farthest upwind.
+// the upwind interval, v1 the farthest upwind. In three parts so that a loop over the first
+// two has no branches and becomes vector code (upwind_batch): the candidates and the
+// smoothness terms; their weighted sum as num / sum; the plain form where that sum under- or
+// overflows (all-zero or extreme differences).
 template <class R>
-[[gnu::always_inline]] inline R weno5(R v1, R v2, R v3, R v4, R v5) {
-  // Divisions by constants written as products (no -ffast-math here); 4 divisions left.
+struct Weno5Parts {
+  R phi1, phi2, phi3, e1, e2, e3;  // third-order candidates; smoothness indicators + epsilon
+};
+
+template <class R>
+[[gnu::always_inline]] inline Weno5Parts<R> weno5_parts(R v1, R v2, R v3, R v4, R v5) {
+  // Divisions by constants written as products (no -ffast-math here).
   constexpr R k3 = R(1) / R(3), k6 = R(1) / R(6), k1312 = R(13) / R(12);
-  const R phi1 = k3 * v1 - R(7) * k6 * v2 + R(11) * k6 * v3;
-  const R phi2 = -k6 * v2 + R(5) * k6 * v3 + k3 * v4;
-  const R phi3 = k3 * v3 + R(5) * k6 * v4 - k6 * v5;
   const R a1 = v1 - R(2) * v2 + v3, b1 = v1 - R(4) * v2 + R(3) * v3;
   const R a2 = v2 - R(2) * v3 + v4, b2 = v2 - v4;
   const R a3 = v3 - R(2) * v4 + v5, b3 = R(3) * v3 - R(4) * v4 + v5;
-  const R s1 = k1312 * a1 * a1 + R(0.25) * b1 * b1;
-  const R s2 = k1312 * a2 * a2 + R(0.25) * b2 * b2;
-  const R s3 = k1312 * a3 * a3 + R(0.25) * b3 * b3;
-  const R vmax = std::max({v1 * v1, v2 * v2, v3 * v3, v4 * v4, v5 * v5});
+  const R vmax = std::max(std::max(std::max(v1 * v1, v2 * v2), std::max(v3 * v3, v4 * v4)), v5 * v5);
   // The tiny term keeps 0/0 away for all-zero differences; its square must not underflow.
   const R eps = R(1e-6) * vmax + (sizeof(R) == sizeof(double) ? R(1e-99) : R(1e-18));
-  const R e1 = s1 + eps, e2 = s2 + eps, e3 = s3 + eps;
-  // Weights d_k / e_k^2 times e1^2 e2^2 e3^2: one division instead of four. Where that
-  // product under- or overflows (all-zero or extreme differences), the plain form.
-  const R q1 = e2 * e3, q2 = e1 * e3, q3 = e1 * e2;
+  return {k3 * v1 - R(7) * k6 * v2 + R(11) * k6 * v3, -k6 * v2 + R(5) * k6 * v3 + k3 * v4,
+          k3 * v3 + R(5) * k6 * v4 - k6 * v5,         k1312 * a1 * a1 + R(0.25) * b1 * b1 + eps,
+          k1312 * a2 * a2 + R(0.25) * b2 * b2 + eps, k1312 * a3 * a3 + R(0.25) * b3 * b3 + eps};
+}
+
+// Weights d_k / e_k^2 times e1^2 e2^2 e3^2: the result is num / sum, one division instead of
+// four, wherever weno5_sum_usable(sum).
+template <class R>
+[[gnu::always_inline]] inline void weno5_weighted(const Weno5Parts<R>& p, R& num, R& sum) {
+  const R q1 = p.e2 * p.e3, q2 = p.e1 * p.e3, q3 = p.e1 * p.e2;
   const R W1 = R(0.1) * q1 * q1, W2 = R(0.6) * q2 * q2, W3 = R(0.3) * q3 * q3;
-  const R sum = W1 + W2 + W3;
-  if (sum > std::numeric_limits<R>::min() && sum < std::numeric_limits<R>::max())
-    return (W1 * phi1 + W2 * phi2 + W3 * phi3) / sum;
-  const R w1 = R(0.1) / (e1 * e1), w2 = R(0.6) / (e2 * e2), w3 = R(0.3) / (e3 * e3);
-  return (w1 * phi1 + w2 * phi2 + w3 * phi3) / (w1 + w2 + w3);
+  sum = W1 + W2 + W3;
+  num = W1 * p.phi1 + W2 * p.phi2 + W3 * p.phi3;
+}
+
+// Whether weno5_weighted's sum is normal and finite (false for NaN).
+template <class R>
+[[gnu::always_inline]] inline bool weno5_sum_usable(R sum) {
+  return sum > std::numeric_limits<R>::min() && sum < std::numeric_limits<R>::max();
+}
+
+template <class R>
+inline R weno5_plain(const Weno5Parts<R>& p) {
+  const R w1 = R(0.1) / (p.e1 * p.e1), w2 = R(0.6) / (p.e2 * p.e2), w3 = R(0.3) / (p.e3 * p.e3);
+  return (w1 * p.phi1 + w2 * p.phi2 + w3 * p.phi3) / (w1 + w2 + w3);
+}
+
+template <class R>
+[[gnu::always_inline]] inline R weno5(R v1, R v2, R v3, R v4, R v5) {
+  const Weno5Parts<R> p = weno5_parts(v1, v2, v3, v4, v5);
+  R num, sum;
+  weno5_weighted(p, num, sum);
+  return weno5_sum_usable(sum) ? num / sum : weno5_plain(p);
 }
 
 // The scheme on any sample type (float in the API; double for tests that need exact data).

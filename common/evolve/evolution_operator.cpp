@@ -16,6 +16,7 @@
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
 
+#include "evolve/axis_lines.hpp"
 #include "evolve/curvature.hpp"
 #include "evolve/curvature_batch.hpp"
 #include "grid/band_accessor.hpp"
@@ -29,10 +30,7 @@ namespace {
 using Clock = std::chrono::steady_clock;
 double since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
 
-// Dense tile around one brick: the brick plus kStencilReach voxels on every side.
-constexpr int kLo = -kStencilReach, kHi = kBrickDim + kStencilReach, kDim = kHi - kLo;
 constexpr std::ptrdiff_t kStride[3] = {1, kDim, kDim * kDim};
-constexpr int tile_index(int x, int y, int z) { return (x - kLo) + kDim * ((y - kLo) + kDim * (z - kLo)); }
 constexpr double kSqrt3 = 1.7320508075688772;
 
 // Per-thread buffers for one brick (at most 512 active voxels).
@@ -42,7 +40,8 @@ struct Scratch {
   std::array<float, kBrickVoxels> d, x, y, z, nx, ny, nz, mean, gauss, k1, k2, grad, beta_a, beta_p;
   std::array<float, kBrickVoxels> dist, dgx, dgy, dgz, dn, img, edge, roi;
   std::array<std::array<OneSided, 3>, kBrickVoxels> os;
-  std::unique_ptr<struct AxisLines> lines;
+  std::unique_ptr<AxisLines> lines;
+  std::unique_ptr<UpwindSides> sides;
   std::array<Vec3d, kBrickVoxels> vel;
   std::array<int, kBrickVoxels> curvature_at_tile;  // tile index whose curvature a voxel takes; -1: none
   // Per brick row (y + 8 z), bit x: the voxel's 19-point curvature stencil is all active
@@ -174,90 +173,17 @@ EdgeStencil edge_stencil(const NarrowBand& band, const Neighborhood& around, con
   return e;
 }
 
-// Lines of samples along each axis through the brick's voxels, with the samples beyond the
-// band's edge (which hold +-W h, not values of the field) replaced by extrapolation from the
-// active samples of the line (quadratic through the last three, linear through two), so that
-// upwind stencils near the edge see a smooth field. line(a, i, j)[k] is the sample at
-// coordinate k - kStencilReach along axis a (k in [0, 14)), at (i, j) in [0, 8)^2 across.
-struct AxisLines {
-  static constexpr int kLen = kDim;
-  std::array<float, 3 * kBrickDim * kBrickDim * kLen> data{};
-  float* line(int a, int i, int j) { return data.data() + std::size_t(((a * kBrickDim + i) * kBrickDim + j) * kLen); }
-  const float* line(int a, int i, int j) const {
-    return data.data() + std::size_t(((a * kBrickDim + i) * kBrickDim + j) * kLen);
+// The one-sided derivatives the upwind terms read: pure advection by a constant velocity needs
+// one side per moving axis (the velocity's upwind side), anything else both.
+SidesWanted sides_wanted(const EvolutionOptions& o, bool advection_only) {
+  SidesWanted w;
+  const bool constant = o.velocity.kind == Velocity::Kind::Constant;
+  for (std::size_t a = 0; a < 3; ++a) {
+    const double v = o.velocity.constant[int(a)];
+    w.minus[a] = !advection_only || !constant || v > 0.0;
+    w.plus[a] = !advection_only || !constant || v < 0.0;
   }
-};
-
-// Fills one line: `active` bit k says sample k is in the band.
-void extrapolate_line(float* v, std::uint32_t active, int reach) {
-  constexpr int n = AxisLines::kLen;
-  int k = 0;
-  while (k < n) {
-    if ((active >> k) & 1u) {
-      ++k;
-      continue;
-    }
-    // Inactive run [k, e).
-    int e = k;
-    while (e < n && !((active >> e) & 1u)) ++e;
-    const bool left = k > 0, right = e < n;
-    for (int g = k; g < e; ++g) {
-      const int dl = g - k + 1, dr = e - g;  // distance to the nearest active sample on each side
-      const bool from_left = left && (!right || dl <= dr);
-      if ((from_left ? dl : dr) > reach || (!left && !right)) continue;
-      const int dir = from_left ? 1 : -1, last = from_left ? k - 1 : e;  // last active sample
-      // Active samples behind `last`, away from the gap (at most 3).
-      int run = 1;
-      while (run < 3) {
-        const int q = last - dir * run;
-        if (q < 0 || q >= n || !((active >> q) & 1u)) break;
-        ++run;
-      }
-      const double p1 = v[last], p2 = run >= 2 ? v[last - dir] : p1, p3 = run >= 3 ? v[last - 2 * dir] : p2;
-      const double t = from_left ? dl : dr;  // steps beyond `last`
-      // Polynomial through (0, p1), (-1, p2), (-2, p3) evaluated at t.
-      double value = p1;
-      if (run == 2) value = p1 + t * (p1 - p2);
-      if (run >= 3) value = p1 + t * (1.5 * p1 - 2.0 * p2 + 0.5 * p3) + 0.5 * t * t * (p1 - 2.0 * p2 + p3);
-      v[g] = float(value);
-    }
-    k = e;
-  }
-}
-
-void fill_axis_lines(const Scratch& s, int reach, AxisLines& lines) {
-  constexpr int n = AxisLines::kLen;
-  constexpr std::uint32_t all = (1u << n) - 1, own = ((1u << kBrickDim) - 1) << (-kLo);  // brick samples
-  auto row = [&](int ty, int tz) { return s.rows[std::size_t(ty + kDim * tz)]; };  // tile-index rows
-  for (int i = 0; i < kBrickDim; ++i)
-    for (int j = 0; j < kBrickDim; ++j) {
-      const int ti = i - kLo, tj = j - kLo;
-      // x lines: (y, z) = (i, j): one row.
-      {
-        const std::uint32_t act = row(ti, tj);
-        if (act & own) {
-          float* l = lines.line(0, i, j);
-          std::copy_n(s.tile.data() + tile_index(kLo, i, j), n, l);
-          if (act != all) extrapolate_line(l, act, reach);
-        }
-      }
-      // y lines: (x, z) = (i, j); z lines: (x, y) = (i, j).
-      std::uint32_t ay = 0, az = 0;
-      for (int k = 0; k < n; ++k) {
-        ay |= ((row(k, tj) >> ti) & 1u) << k;
-        az |= ((row(tj, k) >> ti) & 1u) << k;
-      }
-      if (ay & own) {
-        float* l = lines.line(1, i, j);
-        for (int k = 0; k < n; ++k) l[k] = s.tile[std::size_t(tile_index(i, k + kLo, j))];
-        if (ay != all) extrapolate_line(l, ay, reach);
-      }
-      if (az & own) {
-        float* l = lines.line(2, i, j);
-        for (int k = 0; k < n; ++k) l[k] = s.tile[std::size_t(tile_index(i, j, k + kLo))];
-        if (az != all) extrapolate_line(l, az, reach);
-      }
-    }
+  return w;
 }
 
 // One thread's share of the operator's reductions.
@@ -267,6 +193,67 @@ struct OperatorStats {
   float min_value = std::numeric_limits<float>::infinity(), max_value = -std::numeric_limits<float>::infinity();
   OperatorSeconds seconds;
 };
+
+// The rates of one brick's `count` active voxels from the scratch's one-sided derivatives,
+// speeds, velocities and |grad u|, with the CFL and front-speed reductions.
+void brick_rates(const Scratch& s, const EvolutionOptions& o, int count, double h, float* rate_out, OperatorStats& stats) {
+  const bool moving = has_speed(o), velocity = has_velocity(o);
+  const bool advective = moving && o.speed.has_advective, parabolic = moving && o.speed.has_parabolic;
+  const bool upwind = advective || velocity;
+  const bool llf = o.hamiltonian == Hamiltonian::LaxFriedrichs;
+  for (int i = 0; i < count; ++i) {
+    const std::size_t u = std::size_t(i);
+    const double ba = advective ? double(s.beta_a[u]) : 0.0;
+    const double bp = parabolic ? double(s.beta_p[u]) : 0.0;
+    const Vec3d vel = velocity ? s.vel[u] : Vec3d{};
+    double rate = 0.0;
+    if (upwind) {
+      const OneSided* d = s.os[u].data();
+      const double vw[3] = {vel.x, vel.y, vel.z};
+      if (llf) {
+        const double alpha[3] = {std::abs(ba) + std::abs(vw[0]), std::abs(ba) + std::abs(vw[1]),
+                                 std::abs(ba) + std::abs(vw[2])};
+        rate -= llf_hamiltonian(d, ba, vw, alpha) / h;
+      } else {
+        if (advective && ba != 0.0) rate -= ba * godunov_gradient_norm(d, ba) / h;
+        if (velocity) rate -= upwind_advection(d, vw) / h;
+      }
+    }
+    if (parabolic) rate -= bp * double(s.grad[u]);
+    rate_out[u] = float(rate);
+    const double vsum = std::abs(vel.x) + std::abs(vel.y) + std::abs(vel.z);
+    stats.max_hyp = std::max(stats.max_hyp, kSqrt3 * std::abs(ba) + vsum);
+    const double sp = std::abs(ba) + std::abs(bp) + (velocity ? length(vel) : 0.0);
+    stats.max_speed = std::max(stats.max_speed, sp);
+    // The front's speed: voxels next to the zero level only (curvatures blow up near the
+    // skeleton, deep in the band, without the front moving).
+    if (std::abs(s.d[u]) < 1.5 * h) stats.max_front = std::max(stats.max_front, sp);
+  }
+}
+
+// Pure advection by a constant velocity: brick_rates' arithmetic (upwind_advection, in the same
+// order) straight from the side arrays, for every voxel at once; the reductions are the
+// velocity's.
+void constant_advection_rates(const UpwindSides& sides, const Vec3d& vel, const float* d, int count, double h,
+                              float* rate_out, OperatorStats& stats) {
+  const double* side[3];
+  for (int a = 0; a < 3; ++a) side[a] = vel[a] > 0.0 ? sides.minus[std::size_t(a)].data() : sides.plus[std::size_t(a)].data();
+  const double vx = vel.x, vy = vel.y, vz = vel.z;
+  const bool mx = vx > 0.0 || vx < 0.0, my = vy > 0.0 || vy < 0.0, mz = vz > 0.0 || vz < 0.0;  // axis moves
+  bool front = false;
+  for (int k = 0; k < count; ++k) {
+    double sum = 0.0;
+    sum += mx ? vx * side[0][k] : 0.0;
+    sum += my ? vy * side[1][k] : 0.0;
+    sum += mz ? vz * side[2][k] : 0.0;
+    rate_out[k] = float(0.0 - sum / h);
+    front |= std::abs(d[k]) < 1.5 * h;
+  }
+  const double sp = length(vel);
+  stats.max_hyp = std::max(stats.max_hyp, std::abs(vel.x) + std::abs(vel.y) + std::abs(vel.z));
+  stats.max_speed = std::max(stats.max_speed, sp);
+  if (front) stats.max_front = std::max(stats.max_front, sp);
+}
 
 // The spatial operator on one brick: rates (and betas, edges) for its active voxels.
 void brick_operator(const NarrowBand& band, std::span<const float> decoded, std::uint32_t b, const OperatorSetup& setup,
@@ -282,13 +269,16 @@ void brick_operator(const NarrowBand& band, std::span<const float> decoded, std:
   const std::uint32_t needs = moving ? speed.needs : 0u;
   const bool upwind = advective || velocity;
   const bool advection_only = velocity && !advective && o.hamiltonian == Hamiltonian::Godunov;
+  const bool constant_advection = advection_only && o.velocity.kind == Velocity::Kind::Constant;
   const double h = band.voxel_size();
   const Neighborhood around = brick_neighborhood(band, b);
   gather_box(band, decoded, around, kLo, kHi, s.tile, s.rows);
   stencil_rows(s);
   if (upwind) {
     if (!s.lines) s.lines = std::make_unique<AxisLines>();
-    fill_axis_lines(s, stencil_reach(o.scheme), *s.lines);
+    if (!s.sides) s.sides = std::make_unique<UpwindSides>();
+    fill_axis_lines(s.tile.data(), s.rows.data(), stencil_reach(o.scheme), *s.lines);
+    upwind_sides(*s.lines, band.bricks()[b].active, o.scheme, sides_wanted(o, advection_only), *s.sides);
   }
   const Brick& br = band.bricks()[b];
   const Coord origin = brick_origin(br.coord);
@@ -326,24 +316,19 @@ void brick_operator(const NarrowBand& band, std::span<const float> decoded, std:
       if (needs & kNeedsEdge) s.edge[u] = float(f.edge(world));
       if (needs & kNeedsRoi) s.roi[u] = float(f.roi(world));
     }
-    if (velocity)
+    if (velocity && !constant_advection)
       s.vel[std::size_t(k)] = o.velocity.kind == Velocity::Kind::Constant ? o.velocity.constant
                                                                           : o.velocity.field(world, setup.time);
-    if (upwind) {
-      const AxisLines& ln = *s.lines;
+    if (upwind && !constant_advection) {
       auto& d = s.os[std::size_t(k)];
-      const float* lines[3] = {ln.line(0, l.y, l.z) + (l.x - kLo), ln.line(1, l.x, l.z) + (l.y - kLo),
-                               ln.line(2, l.x, l.y) + (l.z - kLo)};
+      for (int a = 0; a < 3; ++a) d[std::size_t(a)] = s.sides->at(a, k);
       if (advection_only) {
-        // Pure advection upwinds each axis by the velocity's sign: one side is enough.
+        // Pure advection upwinds each axis by the velocity's sign: the other side reads 0.
         const Vec3d& vel = s.vel[std::size_t(k)];
         for (int a = 0; a < 3; ++a) {
-          const bool minus = vel[a] > 0.0;
-          const double side = vel[a] != 0.0 ? one_side(lines[a], 1, o.scheme, minus) : 0.0;
-          d[std::size_t(a)] = minus ? OneSided{side, 0.0} : OneSided{0.0, side};
+          if (!(vel[a] > 0.0)) d[std::size_t(a)].minus = 0.0;
+          if (!(vel[a] < 0.0)) d[std::size_t(a)].plus = 0.0;
         }
-      } else {
-        for (int a = 0; a < 3; ++a) d[std::size_t(a)] = one_sided(lines[a], 1, o.scheme);
       }
     }
     // Central gradient: for the parabolic part, normals, |grad u| and the drift near the front.
@@ -454,35 +439,10 @@ void brick_operator(const NarrowBand& band, std::span<const float> decoded, std:
   }
   const auto t_rates = Clock::now();
   out_seconds.speed += std::chrono::duration<double>(t_rates - t_speed).count();
-  const bool llf = o.hamiltonian == Hamiltonian::LaxFriedrichs;
-  for (int i = 0; i < count; ++i) {
-    const std::size_t u = std::size_t(i);
-    const double ba = advective ? double(s.beta_a[u]) : 0.0;
-    const double bp = parabolic ? double(s.beta_p[u]) : 0.0;
-    const Vec3d vel = velocity ? s.vel[u] : Vec3d{};
-    double rate = 0.0;
-    if (upwind) {
-      const OneSided* d = s.os[u].data();
-      const double vw[3] = {vel.x, vel.y, vel.z};
-      if (llf) {
-        const double alpha[3] = {std::abs(ba) + std::abs(vw[0]), std::abs(ba) + std::abs(vw[1]),
-                                 std::abs(ba) + std::abs(vw[2])};
-        rate -= llf_hamiltonian(d, ba, vw, alpha) / h;
-      } else {
-        if (advective && ba != 0.0) rate -= ba * godunov_gradient_norm(d, ba) / h;
-        if (velocity) rate -= upwind_advection(d, vw) / h;
-      }
-    }
-    if (parabolic) rate -= bp * double(s.grad[u]);
-    out.rate[first + u] = float(rate);
-    const double vsum = std::abs(vel.x) + std::abs(vel.y) + std::abs(vel.z);
-    stats.max_hyp = std::max(stats.max_hyp, kSqrt3 * std::abs(ba) + vsum);
-    const double sp = std::abs(ba) + std::abs(bp) + (velocity ? length(vel) : 0.0);
-    stats.max_speed = std::max(stats.max_speed, sp);
-    // The front's speed: voxels next to the zero level only (curvatures blow up near the
-    // skeleton, deep in the band, without the front moving).
-    if (std::abs(s.d[u]) < 1.5 * h) stats.max_front = std::max(stats.max_front, sp);
-  }
+  if (constant_advection)
+    constant_advection_rates(*s.sides, o.velocity.constant, s.d.data(), count, h, out.rate.data() + first, stats);
+  else
+    brick_rates(s, o, count, h, out.rate.data() + first, stats);
   out_seconds.rates += since(t_rates);
 }
 
