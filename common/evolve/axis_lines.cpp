@@ -1,82 +1,109 @@
 #include "evolve/axis_lines.hpp"
 
 #include <algorithm>
-
+#include <bit>
 
 namespace levelset::evolve::detail {
 
 namespace {
 
-// Fills one line: `active` bit k says sample k is in the band.
-void extrapolate_line(float* v, std::uint32_t active, int reach) {
-  constexpr int n = AxisLines::kLen;
-  int k = 0;
-  while (k < n) {
-    if ((active >> k) & 1u) {
-      ++k;
-      continue;
+constexpr int kLen = AxisLines::kLen;
+constexpr std::uint32_t kAll = (1u << kLen) - 1;
+constexpr std::uint32_t kOwn = ((1u << kBrickDim) - 1) << (-kLo);  // the brick's samples
+
+// The polynomial through the last active sample before a gap and up to two more behind it
+// (away from the gap): (0, p1), (-1, p2), (-2, p3), evaluated t steps into the gap.
+struct GapPolynomial {
+  int run = 0;  // active samples it passes through (1-3); 0: no active sample on that side
+  double p1 = 0, p2 = 0, a = 0, b = 0;
+  GapPolynomial(const float* v, std::uint32_t active, int last, int dir) {
+    run = 1;
+    while (run < 3) {
+      const int q = last - dir * run;
+      if (q < 0 || q >= kLen || !((active >> q) & 1u)) break;
+      ++run;
     }
-    // Inactive run [k, e).
-    int e = k;
-    while (e < n && !((active >> e) & 1u)) ++e;
-    const bool left = k > 0, right = e < n;
-    for (int g = k; g < e; ++g) {
-      const int dl = g - k + 1, dr = e - g;  // distance to the nearest active sample on each side
-      const bool from_left = left && (!right || dl <= dr);
-      if ((from_left ? dl : dr) > reach || (!left && !right)) continue;
-      const int dir = from_left ? 1 : -1, last = from_left ? k - 1 : e;  // last active sample
-      // Active samples behind `last`, away from the gap (at most 3).
-      int run = 1;
-      while (run < 3) {
-        const int q = last - dir * run;
-        if (q < 0 || q >= n || !((active >> q) & 1u)) break;
-        ++run;
-      }
-      const double p1 = v[last], p2 = run >= 2 ? v[last - dir] : p1, p3 = run >= 3 ? v[last - 2 * dir] : p2;
-      const double t = from_left ? dl : dr;  // steps beyond `last`
-      // Polynomial through (0, p1), (-1, p2), (-2, p3) evaluated at t.
-      double value = p1;
-      if (run == 2) value = p1 + t * (p1 - p2);
-      if (run >= 3) value = p1 + t * (1.5 * p1 - 2.0 * p2 + 0.5 * p3) + 0.5 * t * t * (p1 - 2.0 * p2 + p3);
-      v[g] = float(value);
-    }
-    k = e;
+    p1 = v[last];
+    p2 = run >= 2 ? v[last - dir] : p1;
+    const double p3 = run >= 3 ? v[last - 2 * dir] : p2;
+    a = 1.5 * p1 - 2.0 * p2 + 0.5 * p3;
+    b = p1 - 2.0 * p2 + p3;
   }
+  GapPolynomial() = default;
+  double at(double t) const {
+    if (run == 2) return p1 + t * (p1 - p2);
+    if (run >= 3) return p1 + t * a + 0.5 * t * t * b;
+    return p1;
+  }
+};
+
+// Fills the `need`ed inactive samples of one line (`active` bit k: sample k is in the band):
+// each from the nearer side of its gap (the left on a tie), when that side's last active
+// sample is at most `reach` away; samples of a gap with no active side stay as they are.
+void extrapolate_line(float* v, std::uint32_t active, std::uint32_t need, int reach) {
+  while (need) {
+    const int g0 = std::countr_zero(need);
+    // The gap [k, e) around g0.
+    const std::uint32_t below = active & ((1u << g0) - 1), above = active & ~((1u << g0) - 1);
+    const int k = below ? 32 - std::countl_zero(below) : 0, e = above ? std::countr_zero(above) : kLen;
+    const bool left = k > 0, right = e < kLen;
+    const GapPolynomial from_l = left ? GapPolynomial(v, active, k - 1, 1) : GapPolynomial();
+    const GapPolynomial from_r = right ? GapPolynomial(v, active, e, -1) : GapPolynomial();
+    const std::uint32_t gap = (e < 32 ? (1u << e) - 1 : ~0u) & ~((1u << k) - 1);
+    for (std::uint32_t in = need & gap; in; in &= in - 1) {
+      const int g = std::countr_zero(in);
+      const int dl = g - k + 1, dr = e - g;  // distance to the last active sample on each side
+      const bool use_left = left && (!right || dl <= dr);
+      if ((use_left ? dl : dr) > reach || (!left && !right)) continue;
+      v[g] = float(use_left ? from_l.at(dl) : from_r.at(dr));
+    }
+    need &= ~gap;
+  }
+}
+
+// The inactive samples an upwind stencil of half-width `reach` around an active brick sample
+// reads.
+std::uint32_t needed_samples(std::uint32_t active, int reach) {
+  const std::uint32_t centres = active & kOwn;
+  std::uint32_t spread = centres;
+  for (int r = 1; r <= reach; ++r) spread |= (centres << r) | (centres >> r);
+  return spread & ~active & kAll;
+}
+
+void fill_line(float* l, std::uint32_t active, int reach) {
+  if (active == kAll) return;
+  const std::uint32_t need = needed_samples(active, reach);
+  if (need) extrapolate_line(l, active, need, reach);
 }
 
 }  // namespace
 
 void fill_axis_lines(const float* tile, const std::uint32_t* rows, int reach, AxisLines& lines) {
-  constexpr int n = AxisLines::kLen;
-  constexpr std::uint32_t all = (1u << n) - 1, own = ((1u << kBrickDim) - 1) << (-kLo);  // brick samples
   auto row = [&](int ty, int tz) { return rows[std::size_t(ty + kDim * tz)]; };  // tile-index rows
   for (int i = 0; i < kBrickDim; ++i)
     for (int j = 0; j < kBrickDim; ++j) {
       const int ti = i - kLo, tj = j - kLo;
       // x lines: (y, z) = (i, j): one row.
-      {
-        const std::uint32_t act = row(ti, tj);
-        if (act & own) {
-          float* l = lines.line(0, i, j);
-          std::copy_n(tile + tile_index(kLo, i, j), n, l);
-          if (act != all) extrapolate_line(l, act, reach);
-        }
+      if (const std::uint32_t act = row(ti, tj); act & kOwn) {
+        float* l = lines.line(0, i, j);
+        std::copy_n(tile + tile_index(kLo, i, j), kLen, l);
+        fill_line(l, act, reach);
       }
       // y lines: (x, z) = (i, j); z lines: (x, y) = (i, j).
       std::uint32_t ay = 0, az = 0;
-      for (int k = 0; k < n; ++k) {
+      for (int k = 0; k < kLen; ++k) {
         ay |= ((row(k, tj) >> ti) & 1u) << k;
         az |= ((row(tj, k) >> ti) & 1u) << k;
       }
-      if (ay & own) {
+      if (ay & kOwn) {
         float* l = lines.line(1, i, j);
-        for (int k = 0; k < n; ++k) l[k] = tile[tile_index(i, k + kLo, j)];
-        if (ay != all) extrapolate_line(l, ay, reach);
+        for (int k = 0; k < kLen; ++k) l[k] = tile[tile_index(i, k + kLo, j)];
+        fill_line(l, ay, reach);
       }
-      if (az & own) {
+      if (az & kOwn) {
         float* l = lines.line(2, i, j);
-        for (int k = 0; k < n; ++k) l[k] = tile[tile_index(i, j, k + kLo)];
-        if (az != all) extrapolate_line(l, az, reach);
+        for (int k = 0; k < kLen; ++k) l[k] = tile[tile_index(i, j, k + kLo)];
+        fill_line(l, az, reach);
       }
     }
 }

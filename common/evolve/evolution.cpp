@@ -144,6 +144,7 @@ Advanced advance(NarrowBand& cur, const OperatorOutput& op, const OperatorSetup&
       OperatorSetup s2 = setup;
       s2.want_edges = false;
       s2.want_betas = false;
+      s2.want_stats = false;
       cur.swap_values(next);  // cur holds u1, next holds u0
       s2.time = t + dt;
       auto t2 = Clock::now();

@@ -247,39 +247,47 @@ void constant_advection_rates(const UpwindSides& sides, const Vec3d& vel, const 
     sum += my ? vy * side[1][k] : 0.0;
     sum += mz ? vz * side[2][k] : 0.0;
     rate_out[k] = float(0.0 - sum / h);
-    front |= std::abs(d[k]) < 1.5 * h;
   }
+  for (int k = 0; d && k < count; ++k) front |= std::abs(d[k]) < 1.5 * h;
   const double sp = length(vel);
   stats.max_hyp = std::max(stats.max_hyp, std::abs(vel.x) + std::abs(vel.y) + std::abs(vel.z));
   stats.max_speed = std::max(stats.max_speed, sp);
   if (front) stats.max_front = std::max(stats.max_front, sp);
 }
 
-// The spatial operator on one brick: rates (and betas, edges) for its active voxels.
-void brick_operator(const NarrowBand& band, std::span<const float> decoded, std::uint32_t b, const OperatorSetup& setup,
-                    Scratch& s, OperatorOutput& out, OperatorStats& stats) {
-  OperatorSeconds& out_seconds = stats.seconds;
-  const auto t_start = Clock::now();
-  const EvolutionOptions& o = setup.options;
-  const SpeedFunction& speed = o.speed;
-  const bool moving = has_speed(o);
-  const bool advective = moving && speed.has_advective;
-  const bool parabolic = moving && speed.has_parabolic;
-  const bool velocity = has_velocity(o);
-  const std::uint32_t needs = moving ? speed.needs : 0u;
-  const bool upwind = advective || velocity;
-  const bool advection_only = velocity && !advective && o.hamiltonian == Hamiltonian::Godunov;
-  const bool constant_advection = advection_only && o.velocity.kind == Velocity::Kind::Constant;
-  const double h = band.voxel_size();
-  const Neighborhood around = brick_neighborhood(band, b);
-  gather_box(band, decoded, around, kLo, kHi, s.tile, s.rows);
-  stencil_rows(s);
-  if (upwind) {
-    if (!s.lines) s.lines = std::make_unique<AxisLines>();
-    if (!s.sides) s.sides = std::make_unique<UpwindSides>();
-    fill_axis_lines(s.tile.data(), s.rows.data(), stencil_reach(o.scheme), *s.lines);
-    upwind_sides(*s.lines, band.bricks()[b].active, o.scheme, sides_wanted(o, advection_only), *s.sides);
+// What an operator run computes, from its setup (the same for every brick).
+struct OperatorPlan {
+  bool moving, advective, parabolic, velocity, upwind, advection_only, constant_advection;
+  std::uint32_t needs;
+  SidesWanted sides;
+  // Whether the per-voxel pass runs: RK3's later stages of pure advection by a constant
+  // velocity need nothing from it (no speed, statistics or edges).
+  bool voxel_pass;
+  explicit OperatorPlan(const OperatorSetup& setup) {
+    const EvolutionOptions& o = setup.options;
+    moving = has_speed(o);
+    advective = moving && o.speed.has_advective;
+    parabolic = moving && o.speed.has_parabolic;
+    velocity = has_velocity(o);
+    needs = moving ? o.speed.needs : 0u;
+    upwind = advective || velocity;
+    advection_only = velocity && !advective && o.hamiltonian == Hamiltonian::Godunov;
+    constant_advection = advection_only && o.velocity.kind == Velocity::Kind::Constant;
+    sides = sides_wanted(o, advection_only);
+    voxel_pass = !constant_advection || setup.want_stats || setup.want_edges;
   }
+};
+
+// The per-voxel pass over one brick's active voxels (k-th in ascending local index): values,
+// speed inputs (positions, fields, normals, |grad u|, where each curvature comes from),
+// velocities, one-sided derivatives, drift, edges and their stencils. Returns the count.
+int voxel_pass(const NarrowBand& band, const Neighborhood& around, std::uint32_t b, const OperatorSetup& setup,
+               const OperatorPlan& plan, Scratch& s, OperatorOutput& out, OperatorStats& stats) {
+  const EvolutionOptions& o = setup.options;
+  const std::uint32_t needs = plan.needs;
+  const bool velocity = plan.velocity, parabolic = plan.parabolic, upwind = plan.upwind;
+  const bool advection_only = plan.advection_only, constant_advection = plan.constant_advection;
+  const double h = band.voxel_size();
   const Brick& br = band.bricks()[b];
   const Coord origin = brick_origin(br.coord);
   const std::size_t first = br.value_offset;
@@ -332,7 +340,7 @@ void brick_operator(const NarrowBand& band, std::span<const float> decoded, std:
       }
     }
     // Central gradient: for the parabolic part, normals, |grad u| and the drift near the front.
-    const bool near = std::abs(*v) < 2 * h;
+    const bool near = setup.want_stats && std::abs(*v) < 2 * h;
     const bool want_grad = parabolic || near || (needs & (kNeedsNormal | kNeedsGradNorm));
     Vec3d g{};
     if (want_grad)
@@ -371,9 +379,11 @@ void brick_operator(const NarrowBand& band, std::span<const float> decoded, std:
     }
     ++k;
   });
-  const int count = k;
-  const auto t_curvature = Clock::now();
-  out_seconds.gradient += std::chrono::duration<double>(t_curvature - t_start).count();
+  return k;
+}
+
+// Mean, Gaussian and (when the speed reads them) principal curvatures of the brick's voxels.
+void brick_curvatures(const Brick& br, std::uint32_t needs, int count, double h, Scratch& s) {
   if (needs & kNeedsPrincipal) {
     for (int i = 0; i < count; ++i) {
       const int at = s.curvature_at_tile[std::size_t(i)];
@@ -387,60 +397,91 @@ void brick_operator(const NarrowBand& band, std::span<const float> decoded, std:
     mean_gauss_curvature_brick(s.tile.data(), tile_index(0, 0, 0), kStride, br.active, s.curvature_at_tile.data(), h,
                                s.mean.data(), s.gauss.data());
   }
+}
+
+// The speed's betas for the brick's voxels (or the extension velocities), into the scratch
+// and, when wanted, the output.
+void brick_speeds(const OperatorSetup& setup, std::uint32_t needs, std::size_t first, int count, double h,
+                  Scratch& s, OperatorOutput& out) {
+  const SpeedFunction& speed = setup.options.speed;
+  if (setup.beta_a_override) {
+    std::copy_n(setup.beta_a_override + first, count, s.beta_a.data());
+    std::copy_n(setup.beta_p_override + first, count, s.beta_p.data());
+  } else {
+    std::fill_n(s.beta_a.data(), count, 0.0f);
+    std::fill_n(s.beta_p.data(), count, 0.0f);
+    SpeedBatch batch;
+    batch.count = count;
+    batch.time = setup.time;
+    batch.h = h;
+    batch.kavg = setup.kavg;
+    batch.d = s.d.data();
+    if (needs & kNeedsPosition) {
+      batch.x = s.x.data();
+      batch.y = s.y.data();
+      batch.z = s.z.data();
+    }
+    if (needs & kNeedsNormal) {
+      batch.nx = s.nx.data();
+      batch.ny = s.ny.data();
+      batch.nz = s.nz.data();
+    }
+    if (needs & (kNeedsMean | kNeedsPrincipal | kNeedsGauss)) batch.mean = s.mean.data();
+    if (needs & kNeedsGauss) batch.gauss = s.gauss.data();
+    if (needs & kNeedsPrincipal) {
+      batch.gauss = s.gauss.data();
+      batch.k1 = s.k1.data();
+      batch.k2 = s.k2.data();
+    }
+    if (needs & kNeedsGradNorm) batch.grad = s.grad.data();
+    if (needs & kNeedsDist) batch.dist = s.dist.data();
+    if (needs & kNeedsDistGradient) {
+      batch.dgx = s.dgx.data();
+      batch.dgy = s.dgy.data();
+      batch.dgz = s.dgz.data();
+      if (needs & kNeedsNormal) batch.dn = s.dn.data();
+    }
+    if (needs & kNeedsImage) batch.img = s.img.data();
+    if (needs & kNeedsEdge) batch.edge = s.edge.data();
+    if (needs & kNeedsRoi) batch.roi = s.roi.data();
+    speed.eval(batch, SpeedOutput{s.beta_a.data(), s.beta_p.data()});
+  }
+  if (setup.want_betas) {
+    std::copy_n(s.beta_a.data(), count, out.beta_a.data() + first);
+    std::copy_n(s.beta_p.data(), count, out.beta_p.data() + first);
+  }
+}
+
+// The spatial operator on one brick: rates (and betas, edges) for its active voxels.
+void brick_operator(const NarrowBand& band, std::span<const float> decoded, std::uint32_t b, const OperatorSetup& setup,
+                    const OperatorPlan& plan, Scratch& s, OperatorOutput& out, OperatorStats& stats) {
+  OperatorSeconds& out_seconds = stats.seconds;
+  const auto t_start = Clock::now();
+  const EvolutionOptions& o = setup.options;
+  const double h = band.voxel_size();
+  const Brick& br = band.bricks()[b];
+  const std::size_t first = br.value_offset;
+  const Neighborhood around = brick_neighborhood(band, b);
+  gather_box(band, decoded, around, kLo, kHi, s.tile, s.rows);
+  stencil_rows(s);
+  if (plan.upwind) {
+    if (!s.lines) s.lines = std::make_unique<AxisLines>();
+    if (!s.sides) s.sides = std::make_unique<UpwindSides>();
+    fill_axis_lines(s.tile.data(), s.rows.data(), stencil_reach(o.scheme), *s.lines);
+    upwind_sides(*s.lines, br.active, o.scheme, plan.sides, *s.sides);
+  }
+  const int count = plan.voxel_pass ? voxel_pass(band, around, b, setup, plan, s, out, stats) : br.active_count();
+  const auto t_curvature = Clock::now();
+  out_seconds.gradient += std::chrono::duration<double>(t_curvature - t_start).count();
+  brick_curvatures(br, plan.needs, count, h, s);
   const auto t_speed = Clock::now();
   out_seconds.curvature += std::chrono::duration<double>(t_speed - t_curvature).count();
-  if (moving) {
-    if (setup.beta_a_override) {
-      std::copy_n(setup.beta_a_override + first, count, s.beta_a.data());
-      std::copy_n(setup.beta_p_override + first, count, s.beta_p.data());
-    } else {
-      std::fill_n(s.beta_a.data(), count, 0.0f);
-      std::fill_n(s.beta_p.data(), count, 0.0f);
-      SpeedBatch batch;
-      batch.count = count;
-      batch.time = setup.time;
-      batch.h = h;
-      batch.kavg = setup.kavg;
-      batch.d = s.d.data();
-      if (needs & kNeedsPosition) {
-        batch.x = s.x.data();
-        batch.y = s.y.data();
-        batch.z = s.z.data();
-      }
-      if (needs & kNeedsNormal) {
-        batch.nx = s.nx.data();
-        batch.ny = s.ny.data();
-        batch.nz = s.nz.data();
-      }
-      if (needs & (kNeedsMean | kNeedsPrincipal | kNeedsGauss)) batch.mean = s.mean.data();
-      if (needs & kNeedsGauss) batch.gauss = s.gauss.data();
-      if (needs & kNeedsPrincipal) {
-        batch.gauss = s.gauss.data();
-        batch.k1 = s.k1.data();
-        batch.k2 = s.k2.data();
-      }
-      if (needs & kNeedsGradNorm) batch.grad = s.grad.data();
-      if (needs & kNeedsDist) batch.dist = s.dist.data();
-      if (needs & kNeedsDistGradient) {
-        batch.dgx = s.dgx.data();
-        batch.dgy = s.dgy.data();
-        batch.dgz = s.dgz.data();
-        if (needs & kNeedsNormal) batch.dn = s.dn.data();
-      }
-      if (needs & kNeedsImage) batch.img = s.img.data();
-      if (needs & kNeedsEdge) batch.edge = s.edge.data();
-      if (needs & kNeedsRoi) batch.roi = s.roi.data();
-      speed.eval(batch, SpeedOutput{s.beta_a.data(), s.beta_p.data()});
-    }
-    if (setup.want_betas) {
-      std::copy_n(s.beta_a.data(), count, out.beta_a.data() + first);
-      std::copy_n(s.beta_p.data(), count, out.beta_p.data() + first);
-    }
-  }
+  if (plan.moving) brick_speeds(setup, plan.needs, first, count, h, s, out);
   const auto t_rates = Clock::now();
   out_seconds.speed += std::chrono::duration<double>(t_rates - t_speed).count();
-  if (constant_advection)
-    constant_advection_rates(*s.sides, o.velocity.constant, s.d.data(), count, h, out.rate.data() + first, stats);
+  if (plan.constant_advection)
+    constant_advection_rates(*s.sides, o.velocity.constant, setup.want_stats ? s.d.data() : nullptr, count, h,
+                             out.rate.data() + first, stats);
   else
     brick_rates(s, o, count, h, out.rate.data() + first, stats);
   out_seconds.rates += since(t_rates);
@@ -501,13 +542,14 @@ OperatorOutput run_operator(const NarrowBand& band, const OperatorSetup& setup) 
   }
   tbb::combinable<OperatorStats> stats;
   tbb::enumerable_thread_specific<Scratch> scratch;
+  const OperatorPlan plan(setup);
   const DecodedBricks decoded = decode_bricks(band);
   tbb::parallel_for(tbb::blocked_range<std::uint32_t>(0, std::uint32_t(band.brick_count()), 8),
                     [&](const tbb::blocked_range<std::uint32_t>& r) {
     Scratch& s = scratch.local();
     OperatorStats& st = stats.local();
     for (std::uint32_t b = r.begin(); b != r.end(); ++b)
-      brick_operator(band, decoded.values(), b, setup, s, out, st);
+      brick_operator(band, decoded.values(), b, setup, plan, s, out, st);
   });
   stats.combine_each([&](const OperatorStats& st) {
     out.max_hyperbolic = std::max(out.max_hyperbolic, st.max_hyp);

@@ -52,6 +52,9 @@ struct OperatorSetup {
   const float* beta_p_override = nullptr;
   bool want_edges = false;
   bool want_betas = false;  // fill OperatorOutput::beta_a / beta_p
+  // The reductions (CFL and speed bounds, |grad u| drift, value range): off for RK3's later
+  // stages, which use the rates only.
+  bool want_stats = true;
 };
 
 struct OperatorOutput {
