@@ -47,6 +47,11 @@ struct Scratch {
   // Per brick row (y + 8 z), bit x: the voxel's 19-point curvature stencil is all active
   // (whole), its six face neighbours are active (interior).
   std::array<std::uint8_t, kBrickDim * kBrickDim> whole, interior;
+  // Per tile row (y, z) with y, z in [-1, 8]: bit x - kLo says the voxel and its six face
+  // neighbours are active (not an edge voxel); filled for the edge stencils only.
+  std::array<std::uint32_t, (kBrickDim + 2) * (kBrickDim + 2)> inner;
+  // The band's bricks around this one (Neighborhood slots), for band value indices.
+  std::array<const Brick*, 27> around_bricks;
 };
 
 bool active_at(const Scratch& s, int x, int y, int z) {
@@ -114,29 +119,37 @@ void stencil_rows(Scratch& s) {
     }
 }
 
-bool is_edge(const Scratch& s, const Coord& l) {
-  for (int a = 0; a < 3; ++a)
-    for (int sgn = -1; sgn <= 1; sgn += 2) {
-      Coord q = l;
-      q[a] += sgn;
-      if (!active_at(s, q.x, q.y, q.z)) return true;
+// Scratch::inner and Scratch::around_bricks, for the edge stencils.
+void edge_rows(const NarrowBand& band, const Neighborhood& around, Scratch& s) {
+  auto row = [&](int y, int z) { return s.rows[std::size_t((y - kLo) + kDim * (z - kLo))]; };
+  for (int z = -1; z <= kBrickDim; ++z)
+    for (int y = -1; y <= kBrickDim; ++y) {
+      const std::uint32_t r = row(y, z);
+      s.inner[std::size_t((y + 1) + (kBrickDim + 2) * (z + 1))] =
+          r & (r >> 1) & (r << 1) & row(y - 1, z) & row(y + 1, z) & row(y, z - 1) & row(y, z + 1);
     }
-  return false;
+  for (std::size_t k = 0; k < 27; ++k) s.around_bricks[k] = around[k] == kNoBrick ? nullptr : &band.bricks()[around[k]];
+}
+
+// Whether active voxel l (brick-local, within one voxel of the brick) has an inactive face
+// neighbour.
+bool is_edge(const Scratch& s, const Coord& l) {
+  return !((s.inner[std::size_t((l.y + 1) + (kBrickDim + 2) * (l.z + 1))] >> (l.x - kLo)) & 1u);
 }
 
 // Band value index of the active voxel at brick-local coordinates q (within one brick of the
 // brick itself).
-std::uint32_t value_index(const NarrowBand& band, const Neighborhood& around, const Coord& q) {
+std::uint32_t value_index(const Scratch& s, const Coord& q) {
   const int bx = q.x < 0 ? -1 : (q.x >= kBrickDim ? 1 : 0), by = q.y < 0 ? -1 : (q.y >= kBrickDim ? 1 : 0),
             bz = q.z < 0 ? -1 : (q.z >= kBrickDim ? 1 : 0);
-  const Brick& br = band.bricks()[around[std::size_t(Neighborhood::slot(bx, by, bz))]];
+  const Brick& br = *s.around_bricks[std::size_t(Neighborhood::slot(bx, by, bz))];
   return std::uint32_t(br.value_offset + std::uint32_t(br.slot(local_index(q.x & 7, q.y & 7, q.z & 7))));
 }
 
 // The extrapolation of edge voxel l from the interior (see EdgeStencil): quadratic through the
 // next three active voxels along a direction (linear through two), the first one not itself
 // an edge voxel, on the direction where u changes fastest.
-EdgeStencil edge_stencil(const NarrowBand& band, const Neighborhood& around, const Scratch& s, const Coord& l) {
+EdgeStencil edge_stencil(const Scratch& s, const Coord& l) {
   EdgeStencil e;
   double step = -1.0;
   int best_face = -1, best_count = 0;
@@ -162,13 +175,13 @@ EdgeStencil edge_stencil(const NarrowBand& band, const Neighborhood& around, con
   for (int k = 0; k < best_count; ++k) {
     Coord q = l;
     q[best_face >> 1] += ((best_face & 1) ? 1 : -1) * (k + 1);
-    e.source[std::size_t(k)] = value_index(band, around, q);
+    e.source[std::size_t(k)] = value_index(s, q);
   }
   e.coef = best_count == 3 ? std::array<float, 3>{3.0f, -3.0f, 1.0f} : std::array<float, 3>{2.0f, -1.0f, 0.0f};
   for (int f = 0; f < 6; ++f) {
     Coord q = l;
     q[f >> 1] += (f & 1) ? 1 : -1;
-    if (active_at(s, q.x, q.y, q.z)) e.neighbor[e.neighbors++] = value_index(band, around, q);
+    if (active_at(s, q.x, q.y, q.z)) e.neighbor[e.neighbors++] = value_index(s, q);
   }
   return e;
 }
@@ -292,6 +305,7 @@ int voxel_pass(const NarrowBand& band, const Neighborhood& around, std::uint32_t
   const Coord origin = brick_origin(br.coord);
   const std::size_t first = br.value_offset;
   if (setup.want_edges) {
+    edge_rows(band, around, s);
     // One allocation for the brick's edge stencils (at most one per edge voxel).
     int edges = 0;
     for (int r = 0; r < kBrickDim * kBrickDim; ++r)
@@ -371,7 +385,7 @@ int voxel_pass(const NarrowBand& band, const Neighborhood& around, std::uint32_t
                          unsigned((v[0] < 0.0f) != (v[kDim * kDim] < 0.0f));
     if (setup.want_edges && !((s.interior[std::size_t(l.y + kBrickDim * l.z)] >> l.x) & 1u)) {
       out.edge[first + std::size_t(k)] = 1;
-      EdgeStencil e = edge_stencil(band, around, s, l);
+      EdgeStencil e = edge_stencil(s, l);
       if (e.count > 0) {
         e.target = std::uint32_t(first + std::size_t(k));
         out.edge_stencils[b].push_back(e);
