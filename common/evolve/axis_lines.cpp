@@ -11,53 +11,50 @@ constexpr int kLen = AxisLines::kLen;
 constexpr std::uint32_t kAll = (1u << kLen) - 1;
 constexpr std::uint32_t kOwn = ((1u << kBrickDim) - 1) << (-kLo);  // the brick's samples
 
-// The polynomial through the last active sample before a gap and up to two more behind it
-// (away from the gap): (0, p1), (-1, p2), (-2, p3), evaluated t steps into the gap.
-struct GapPolynomial {
-  int run = 0;  // active samples it passes through (1-3); 0: no active sample on that side
-  double p1 = 0, p2 = 0, a = 0, b = 0;
-  GapPolynomial(const float* v, std::uint32_t active, int last, int dir) {
-    run = 1;
-    while (run < 3) {
-      const int q = last - dir * run;
-      if (q < 0 || q >= kLen || !((active >> q) & 1u)) break;
-      ++run;
-    }
-    p1 = v[last];
-    p2 = run >= 2 ? v[last - dir] : p1;
-    const double p3 = run >= 3 ? v[last - 2 * dir] : p2;
-    a = 1.5 * p1 - 2.0 * p2 + 0.5 * p3;
-    b = p1 - 2.0 * p2 + p3;
+// Bits [lo, hi] (none when hi < lo).
+constexpr std::uint32_t bit_range(int lo, int hi) {
+  return hi < lo ? 0u : ((hi >= 31 ? ~0u : (2u << hi) - 1u) & ~((1u << lo) - 1u));
+}
+
+// Fills the samples `fill` of a gap (in v) from the polynomial through its last active sample `last`
+// and up to two more behind it, away from the gap (dir = +1: the gap lies above `last`):
+// through (0, p1), (-1, p2), (-2, p3) evaluated t = |g - last| steps into the gap; linear
+// through two samples, constant through one. Without branches on the sample count.
+void fill_from(float* v, const float* src, std::ptrdiff_t stride, std::uint32_t active, int last, int dir,
+               std::uint32_t fill) {
+  auto on = [&](int q) { return q >= 0 && q < kLen && ((active >> q) & 1u); };
+  auto at = [&](int q) { return double(src[q * stride]); };
+  const int run = on(last - dir) ? (on(last - 2 * dir) ? 3 : 2) : 1;
+  const double p1 = at(last), p2 = run >= 2 ? at(last - dir) : p1, p3 = run >= 3 ? at(last - 2 * dir) : p2;
+  const double a = run >= 3 ? 1.5 * p1 - 2.0 * p2 + 0.5 * p3 : run == 2 ? p1 - p2 : 0.0;
+  const double b = run >= 3 ? p1 - 2.0 * p2 + p3 : 0.0;
+  for (; fill; fill &= fill - 1) {
+    const int g = std::countr_zero(fill);
+    const double t = double((g - last) * dir);
+    v[g] = float(p1 + t * a + 0.5 * t * t * b);
   }
-  GapPolynomial() = default;
-  double at(double t) const {
-    if (run == 2) return p1 + t * (p1 - p2);
-    if (run >= 3) return p1 + t * a + 0.5 * t * t * b;
-    return p1;
-  }
-};
+}
 
 // Fills the `need`ed inactive samples of one line (`active` bit k: sample k is in the band):
 // each from the nearer side of its gap (the left on a tie), when that side's last active
 // sample is at most `reach` away; samples of a gap with no active side stay as they are.
-void extrapolate_line(float* v, std::uint32_t active, std::uint32_t need, int reach) {
+// The active samples are read from the tile (src, with its stride along the line), not from
+// the line just copied from it: a load right after a wide vector store of the copy would wait
+// for store forwarding.
+void extrapolate_line(float* v, const float* src, std::ptrdiff_t stride, std::uint32_t active, std::uint32_t need,
+                      int reach) {
   while (need) {
     const int g0 = std::countr_zero(need);
     // The gap [k, e) around g0.
     const std::uint32_t below = active & ((1u << g0) - 1), above = active & ~((1u << g0) - 1);
     const int k = below ? 32 - std::countl_zero(below) : 0, e = above ? std::countr_zero(above) : kLen;
     const bool left = k > 0, right = e < kLen;
-    const GapPolynomial from_l = left ? GapPolynomial(v, active, k - 1, 1) : GapPolynomial();
-    const GapPolynomial from_r = right ? GapPolynomial(v, active, e, -1) : GapPolynomial();
-    const std::uint32_t gap = (e < 32 ? (1u << e) - 1 : ~0u) & ~((1u << k) - 1);
-    for (std::uint32_t in = need & gap; in; in &= in - 1) {
-      const int g = std::countr_zero(in);
-      const int dl = g - k + 1, dr = e - g;  // distance to the last active sample on each side
-      const bool use_left = left && (!right || dl <= dr);
-      if ((use_left ? dl : dr) > reach || (!left && !right)) continue;
-      v[g] = float(use_left ? from_l.at(dl) : from_r.at(dr));
-    }
-    need &= ~gap;
+    // Samples g with dl = g - k + 1 <= dr = e - g take the left side (all of them without a
+    // right side), each side within `reach`.
+    const int split = right ? (e + k - 1) / 2 : e - 1;
+    if (left) fill_from(v, src, stride, active, k - 1, 1, need & bit_range(k, std::min(split, k + reach - 1)));
+    if (right) fill_from(v, src, stride, active, e, -1, need & bit_range(std::max(left ? split + 1 : k, e - reach), e - 1));
+    need &= ~bit_range(k, e - 1);
   }
 }
 
@@ -70,42 +67,56 @@ std::uint32_t needed_samples(std::uint32_t active, int reach) {
   return spread & ~active & kAll;
 }
 
-void fill_line(float* l, std::uint32_t active, int reach) {
+// Copies a line of the tile (src: its first sample, stride along it) and extrapolates it.
+void fill_line(float* l, const float* src, std::ptrdiff_t stride, std::uint32_t active, int reach) {
+  for (int k = 0; k < kLen; ++k) l[k] = src[k * stride];
   if (active == kAll) return;
   const std::uint32_t need = needed_samples(active, reach);
-  if (need) extrapolate_line(l, active, need, reach);
+  if (need) extrapolate_line(l, src, stride, active, need, reach);
+}
+
+// Transposes the brick's 8 columns of kLen tile rows: bit k of out[i] is bit i - kLo of
+// row_at(k). Eight columns at a time in the bytes of two words (k < 8 and k >= 8).
+template <class Rows>
+std::array<std::uint32_t, kBrickDim> brick_columns(Rows row_at) {
+  std::uint64_t lo = 0, hi = 0;
+  for (int k = 0; k < kLen; ++k) {
+    // Byte i of t holds the row's brick bits; keep bit i in byte i, then move it to bit 0.
+    const std::uint64_t t = std::uint64_t((row_at(k) >> -kLo) & 0xffu) * 0x0101010101010101ull;
+    const std::uint64_t v = (((t & 0x8040201008040201ull) + 0x7f7f7f7f7f7f7f7full) & 0x8080808080808080ull) >> 7;
+    if (k < 8)
+      lo |= v << k;
+    else
+      hi |= v << (k - 8);
+  }
+  std::array<std::uint32_t, kBrickDim> out;
+  for (int i = 0; i < kBrickDim; ++i)
+    out[std::size_t(i)] = std::uint32_t((lo >> (8 * i)) & 0xffu) | std::uint32_t((hi >> (8 * i)) & 0xffu) << 8;
+  return out;
 }
 
 }  // namespace
 
 void fill_axis_lines(const float* tile, const std::uint32_t* rows, int reach, AxisLines& lines) {
   auto row = [&](int ty, int tz) { return rows[std::size_t(ty + kDim * tz)]; };  // tile-index rows
-  for (int i = 0; i < kBrickDim; ++i)
-    for (int j = 0; j < kBrickDim; ++j) {
-      const int ti = i - kLo, tj = j - kLo;
+  for (int j = 0; j < kBrickDim; ++j) {
+    const int tj = j - kLo;
+    // Active bits along y of the lines (x, z) = (i, j), and along z of the lines (x, y) = (i, j).
+    const std::array<std::uint32_t, kBrickDim> ys = brick_columns([&](int k) { return row(k, tj); });
+    const std::array<std::uint32_t, kBrickDim> zs = brick_columns([&](int k) { return row(tj, k); });
+    for (int i = 0; i < kBrickDim; ++i) {
       // x lines: (y, z) = (i, j): one row.
-      if (const std::uint32_t act = row(ti, tj); act & kOwn) {
-        float* l = lines.line(0, i, j);
-        std::copy_n(tile + tile_index(kLo, i, j), kLen, l);
-        fill_line(l, act, reach);
+      if (const std::uint32_t act = row(i - kLo, tj); act & kOwn) {
+        fill_line(lines.line(0, i, j), tile + tile_index(kLo, i, j), 1, act, reach);
       }
-      // y lines: (x, z) = (i, j); z lines: (x, y) = (i, j).
-      std::uint32_t ay = 0, az = 0;
-      for (int k = 0; k < kLen; ++k) {
-        ay |= ((row(k, tj) >> ti) & 1u) << k;
-        az |= ((row(tj, k) >> ti) & 1u) << k;
+      if (const std::uint32_t ay = ys[std::size_t(i)]; ay & kOwn) {
+        fill_line(lines.line(1, i, j), tile + tile_index(i, kLo, j), kDim, ay, reach);
       }
-      if (ay & kOwn) {
-        float* l = lines.line(1, i, j);
-        for (int k = 0; k < kLen; ++k) l[k] = tile[tile_index(i, k + kLo, j)];
-        fill_line(l, ay, reach);
-      }
-      if (az & kOwn) {
-        float* l = lines.line(2, i, j);
-        for (int k = 0; k < kLen; ++k) l[k] = tile[tile_index(i, j, k + kLo)];
-        fill_line(l, az, reach);
+      if (const std::uint32_t az = zs[std::size_t(i)]; az & kOwn) {
+        fill_line(lines.line(2, i, j), tile + tile_index(i, j, kLo), kDim * kDim, az, reach);
       }
     }
+  }
 }
 
 void upwind_sides(const AxisLines& lines, const BrickMask& active, Scheme scheme, const SidesWanted& want,
