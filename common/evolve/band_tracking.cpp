@@ -1,6 +1,7 @@
 #include "evolve/band_tracking.hpp"
 
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <cmath>
 
@@ -11,6 +12,64 @@
 #include "distance/redistance_domain.hpp"
 
 namespace levelset::evolve {
+
+namespace {
+
+// A brick of the tracking domain and its six face neighbours (slot 0: the brick, 1 + f: the
+// neighbour across face f = 2 a + (1 if +a)), resolved once per brick: the voxels up to
+// three steps along an axis from the brick lie in these.
+struct BrickStar {
+  std::array<const float*, 7> value{};  // unsigned distances (voxels); null: no brick
+  std::array<const BrickMask*, 7> active{}, inside{}, edge{};
+
+  struct At {
+    int slot = -1, index = 0;  // slot -1: outside the domain
+  };
+  // The voxel `steps` (1-3) from brick-local l across face direction f.
+  static At step(const Coord& l, int f, int steps, const BrickStar& star) {
+    const int a = f >> 1;
+    Coord q = l;
+    q[a] += (f & 1) ? steps : -steps;
+    int slot = 0;
+    if (q[a] < 0 || q[a] >= kBrickDim) {
+      slot = 1 + f;
+      q[a] -= (f & 1) ? kBrickDim : -kBrickDim;
+    }
+    if (!star.value[std::size_t(slot)]) return {};
+    return {slot, local_index(q.x, q.y, q.z)};
+  }
+  bool is_active(At p) const { return p.slot >= 0 && active[std::size_t(p.slot)]->test(p.index); }
+  bool is_inside(At p) const { return inside[std::size_t(p.slot)]->test(p.index); }
+  float distance(At p) const { return value[std::size_t(p.slot)][p.index]; }
+  // Signed value (voxels) of a previously active voxel.
+  float signed_at(At p) const { return is_inside(p) ? -distance(p) : distance(p); }
+};
+
+// Bit i of the result: the neighbour of voxel i across face f is set in the mask (star[0]: the
+// brick's, star[1 + f]: its face neighbours'; null: an empty mask). Layout (brick_mask.hpp):
+// word = z-slice, byte = y-row, bit = x.
+BrickMask neighbour_bits(const std::array<BrickMask, 7>& star, int f) {
+  constexpr std::uint64_t kCol0 = 0x0101010101010101ull, kCol7 = 0x8080808080808080ull;
+  const BrickMask& m = star[0];
+  const BrickMask& o = star[std::size_t(1 + f)];
+  BrickMask r;
+  for (int z = 0; z < 8; ++z) {
+    const std::uint64_t a = m.words[std::size_t(z)];
+    std::uint64_t v = 0;
+    switch (f) {
+      case 0: v = (a << 1 & ~kCol0) | (o.words[std::size_t(z)] & kCol7) >> 7; break;
+      case 1: v = (a >> 1 & ~kCol7) | (o.words[std::size_t(z)] & kCol0) << 7; break;
+      case 2: v = a << 8 | o.words[std::size_t(z)] >> 56; break;
+      case 3: v = a >> 8 | o.words[std::size_t(z)] << 56; break;
+      case 4: v = z > 0 ? m.words[std::size_t(z - 1)] : o.words[7]; break;
+      default: v = z < 7 ? m.words[std::size_t(z + 1)] : o.words[0]; break;
+    }
+    r.words[std::size_t(z)] = v;
+  }
+  return r;
+}
+
+}  // namespace
 
 TrackResult track_band(const NarrowBand& moved, const TrackOptions& options) {
   const double w_half = options.half_width;
@@ -39,19 +98,6 @@ TrackResult track_band(const NarrowBand& moved, const TrackOptions& options) {
   // from the interior instead: linearly, 2 u1 - u2, from the two next voxels inward along
   // the axis and direction where u changes fastest (the one nearest the normal); exact for
   // linear u, second order for smooth u.
-  auto neighbor = [&](std::size_t b, const Coord& l, int f, std::size_t& nb) -> int {
-    const int a = f >> 1;
-    Coord q = l;
-    q[a] += (f & 1) ? 1 : -1;
-    nb = b;
-    if (q[a] < 0 || q[a] >= kBrickDim) {
-      const std::uint32_t o = w.nbr[b][std::size_t(f)];
-      if (o == kNoBrick) return -1;
-      nb = o;
-      q[a] = (q[a] + kBrickDim) % kBrickDim;
-    }
-    return local_index(q.x, q.y, q.z);
-  };
   // Edge voxels by mask arithmetic: active voxels with an inactive 6-neighbour (a missing
   // brick counts as inactive). Layout (brick_mask.hpp): word = z-slice, byte = y-row, bit = x.
   std::vector<BrickMask> edge(n);
@@ -78,42 +124,50 @@ TrackResult track_band(const NarrowBand& moved, const TrackOptions& options) {
       }
     }
   });
-  // Signed value (voxels) of a previously active voxel: the polynomial runs across the zero
-  // level, where u is smooth.
-  auto signed_at = [&](std::size_t b, int j) {
-    const float d = w.values(std::uint32_t(b))[j];
-    return w.inside[b].test(j) ? -d : d;
+  auto star_of = [&](std::size_t b) {
+    BrickStar st;
+    auto set = [&](std::size_t slot, std::uint32_t o) {
+      if (o == kNoBrick) return;
+      st.value[slot] = w.values(o);
+      st.active[slot] = &old_active[o];
+      st.inside[slot] = &w.inside[o];
+      st.edge[slot] = &edge[o];
+    };
+    set(0, std::uint32_t(b));
+    for (std::size_t f = 0; f < 6; ++f) set(1 + f, w.nbr[b][f]);
+    return st;
   };
-  // Extrapolation to voxel i of brick b from previously active voxels along the 6 axis
-  // directions: quadratic through the next three (linear through two), on the direction
-  // where u changes fastest; the first one must not be an edge voxel when skip_edge. Returns
-  // the distance (voxels) when the result lies on the voxel's own side, else -1.
-  auto extrapolate = [&](std::size_t b, int i, bool skip_edge) {
+  // Extrapolation to voxel i of the star's brick from previously active voxels along the 6
+  // axis directions: quadratic through the next three (linear through two), on the direction
+  // where u changes fastest; the first one must not be an edge voxel when skip_edge. Signed
+  // values: the polynomial runs across the zero level, where u is smooth. Returns the
+  // distance (voxels) when the result lies on the voxel's own side, else -1.
+  auto extrapolate = [&](const BrickStar& st, int i, bool skip_edge) {
+    using At = BrickStar::At;
     const Coord l = local_coord(i);
+    const bool in_self = st.inside[0]->test(i);
     float best = 0.0f, step = -1.0f;
     for (int f = 0; f < 6; ++f) {
-      std::size_t b1, b2, b3;
-      const int j1 = neighbor(b, l, f, b1);
-      if (j1 < 0 || !old_active[b1].test(j1) || (skip_edge && edge[b1].test(j1))) continue;
-      const int j2 = neighbor(b1, local_coord(j1), f, b2);
-      if (j2 < 0 || !old_active[b2].test(j2)) continue;
-      const float u1 = signed_at(b1, j1), u2 = signed_at(b2, j2);
+      const At p1 = BrickStar::step(l, f, 1, st);
+      if (!st.is_active(p1) || (skip_edge && st.edge[std::size_t(p1.slot)]->test(p1.index))) continue;
+      const At p2 = BrickStar::step(l, f, 2, st);
+      if (!st.is_active(p2)) continue;
+      const float u1 = st.signed_at(p1), u2 = st.signed_at(p2);
       if (std::abs(u1 - u2) <= step) continue;
       step = std::abs(u1 - u2);
       best = 2.0f * u1 - u2;
-      const int j3 = neighbor(b2, local_coord(j2), f, b3);
-      if (j3 >= 0 && old_active[b3].test(j3)) best = 3.0f * u1 - 3.0f * u2 + signed_at(b3, j3);
+      const At p3 = BrickStar::step(l, f, 3, st);
+      if (st.is_active(p3)) best = 3.0f * u1 - 3.0f * u2 + st.signed_at(p3);
     }
-    if (step < 0.0f || (w.inside[b].test(i) ? best >= 0.0f : best <= 0.0f)) return -1.0f;
+    if (step < 0.0f || (in_self ? best >= 0.0f : best <= 0.0f)) return -1.0f;
     // A distance changes by at most one voxel per voxel: clamp to the range every active
     // 6-neighbour on the same side allows (a polynomial through a kink could leave it, and a
     // value pushed beyond W would leave a hole next to the front).
     float lo = 0.0f, hi = detail::kInf;
     for (int f = 0; f < 6; ++f) {
-      std::size_t nb;
-      const int j = neighbor(b, l, f, nb);
-      if (j < 0 || !old_active[nb].test(j) || w.inside[nb].test(j) != w.inside[b].test(i)) continue;
-      const float d = w.values(std::uint32_t(nb))[j];
+      const At p = BrickStar::step(l, f, 1, st);
+      if (!st.is_active(p) || st.is_inside(p) != in_self) continue;
+      const float d = st.distance(p);
       lo = std::max(lo, d - 1.0f);
       hi = std::min(hi, d + 1.0f);
     }
@@ -122,11 +176,14 @@ TrackResult track_band(const NarrowBand& moved, const TrackOptions& options) {
   std::vector<std::vector<std::pair<int, float>>> edge_values(n);
   if (options.extrapolate_edge)
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 32), [&](const tbb::blocked_range<std::size_t>& r) {
-    for (std::size_t b = r.begin(); b != r.end(); ++b)
+    for (std::size_t b = r.begin(); b != r.end(); ++b) {
+      if (edge[b].none()) continue;
+      const BrickStar st = star_of(b);
       edge[b].for_each_set([&](int i) {
-        const float d = extrapolate(b, i, true);
+        const float d = extrapolate(st, i, true);
         if (d >= 0.0f) edge_values[b].push_back({i, d});
       });
+    }
   });
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 32), [&](const tbb::blocked_range<std::size_t>& r) {
     for (std::size_t b = r.begin(); b != r.end(); ++b)
@@ -144,20 +201,35 @@ TrackResult track_band(const NarrowBand& moved, const TrackOptions& options) {
       std::uint64_t count = 0;
       BrickMask fresh;
       for (int z = 0; z < 8; ++z) fresh.words[std::size_t(z)] = w.domain[b].words[std::size_t(z)] & ~old_active[b].words[std::size_t(z)];
+      if (fresh.none()) continue;
+      const BrickStar st = star_of(b);
+      // Per face: the fresh voxels whose neighbour across it is previously active and on the
+      // same side, by mask arithmetic.
+      std::array<BrickMask, 7> in_star{}, out_star{};
+      for (std::size_t k = 0; k < 7; ++k)
+        if (st.value[k])
+          for (std::size_t z = 0; z < 8; ++z) {
+            in_star[k].words[z] = st.active[k]->words[z] & st.inside[k]->words[z];
+            out_star[k].words[z] = st.active[k]->words[z] & ~st.inside[k]->words[z];
+          }
+      std::array<BrickMask, 6> same_side;
+      for (int f = 0; f < 6; ++f) {
+        const BrickMask in_n = neighbour_bits(in_star, f), out_n = neighbour_bits(out_star, f);
+        for (std::size_t z = 0; z < 8; ++z)
+          same_side[std::size_t(f)].words[z] = fresh.words[z] & ((st.inside[0]->words[z] & in_n.words[z]) |
+                                                                  (~st.inside[0]->words[z] & out_n.words[z]));
+      }
       fresh.for_each_set([&](int i) {
         const Coord l = local_coord(i);
         float m[3] = {detail::kInf, detail::kInf, detail::kInf};
-        for (int f = 0; f < 6; ++f) {
-          std::size_t nb;
-          const int j = neighbor(b, l, f, nb);
-          if (j < 0 || !old_active[nb].test(j) || w.inside[nb].test(j) != w.inside[b].test(i)) continue;
-          m[f >> 1] = std::min(m[f >> 1], w.values(std::uint32_t(nb))[j]);
-        }
+        for (int f = 0; f < 6; ++f)
+          if (same_side[std::size_t(f)].test(i))
+            m[f >> 1] = std::min(m[f >> 1], st.distance(BrickStar::step(l, f, 1, st)));
         // The high-order extrapolation where it agrees with that to half a voxel (smooth
         // field; stencils near the edge read it), the Godunov value where it does not.
         const float first_order = detail::godunov(m[0], m[1], m[2]);
         // Beyond W + 1/2 neither value activates the voxel: skip the extrapolation.
-        const float high = first_order <= float(w_half) + 0.5f ? extrapolate(b, i, false) : -1.0f;
+        const float high = first_order <= float(w_half) + 0.5f ? extrapolate(st, i, false) : -1.0f;
         const float best = high >= 0.0f && std::abs(high - first_order) <= 0.5f ? high : first_order;
         d[i] = best;
         count += best <= float(w_half);
