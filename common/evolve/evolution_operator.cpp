@@ -476,8 +476,9 @@ void brick_operator(const NarrowBand& band, std::span<const float> decoded, std:
   const Brick& br = band.bricks()[b];
   const std::size_t first = br.value_offset;
   const Neighborhood around = brick_neighborhood(band, b);
-  gather_box(band, decoded, around, kLo, kHi, s.tile, s.rows);
-  stencil_rows(s);
+  // Without the per-voxel pass only the axis lines read the tile: the star is enough.
+  gather_box(band, decoded, around, kLo, kHi, s.tile, s.rows, plan.voxel_pass ? GatherRegion::Box : GatherRegion::Star);
+  if (plan.voxel_pass) stencil_rows(s);
   if (plan.upwind) {
     if (!s.lines) s.lines = std::make_unique<AxisLines>();
     if (!s.sides) s.sides = std::make_unique<UpwindSides>();

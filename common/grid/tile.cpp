@@ -106,7 +106,7 @@ inline void copy_row(const float* src, float* dst, int width) {
 // neighbour nb to dst[x].
 template <typename FillRow>
 void gather_box_rows(const NarrowBand& band, const Neighborhood& around, int lo, int hi, std::span<float> out,
-                     std::span<std::uint32_t> active_rows, FillRow&& fill_row) {
+                     std::span<std::uint32_t> active_rows, GatherRegion region, FillRow&& fill_row) {
   const std::uint32_t brick = around[std::size_t(Neighborhood::slot(0, 0, 0))];
   if (lo < -kBrickDim || lo > 0 || hi < kBrickDim || hi > 2 * kBrickDim)
     throw Error(ErrorCode::InvalidArgument, "gather_box", "need -8 <= lo <= 0 and 8 <= hi <= 16");
@@ -127,6 +127,7 @@ void gather_box_rows(const NarrowBand& band, const Neighborhood& around, int lo,
     for (int dy = -1; dy <= 1; ++dy) {
       for (int dx = -1; dx <= 1; ++dx) {
         const Coord d{dx, dy, dz};
+        if (region == GatherRegion::Star && (dx != 0) + (dy != 0) + (dz != 0) > 1) continue;
         // Local range of the neighbour that falls into the box, per axis.
         int nlo[3], nhi[3];
         bool empty = false;
@@ -185,7 +186,7 @@ void gather_box(const NarrowBand& band, const Neighborhood& around, int lo, int 
   const float* all_values = band.values().data();
   // A row of a brick is one byte of its masks, and its active values are contiguous in the
   // packed storage.
-  gather_box_rows(band, around, lo, hi, out, active_rows,
+  gather_box_rows(band, around, lo, hi, out, active_rows, GatherRegion::Box,
                   [&](std::uint32_t, const Brick& br, int z, int y, int x0, int x1, int width, float* dst) {
     const std::uint64_t act_word = br.active.words[std::size_t(z)];
     const int bit0 = 8 * y;
@@ -227,10 +228,10 @@ DecodedBricks decode_bricks(const NarrowBand& band) {
 }
 
 void gather_box(const NarrowBand& band, std::span<const float> decoded, const Neighborhood& around, int lo, int hi,
-                std::span<float> out, std::span<std::uint32_t> active_rows) {
+                std::span<float> out, std::span<std::uint32_t> active_rows, GatherRegion region) {
   if (decoded.size() != band.brick_count() * std::size_t(kBrickVoxels))
     throw Error(ErrorCode::InvalidArgument, "gather_box", "decoded bricks do not match the band");
-  gather_box_rows(band, around, lo, hi, out, active_rows,
+  gather_box_rows(band, around, lo, hi, out, active_rows, region,
                   [&](std::uint32_t nb, const Brick&, int z, int y, int x0, int, int width, float* dst) {
     copy_row(decoded.data() + std::size_t(nb) * kBrickVoxels + std::size_t(local_index(x0, y, z)), dst + x0, width);
   });

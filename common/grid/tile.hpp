@@ -68,9 +68,13 @@ struct DecodedBricks {
   std::span<const float> values() const { return {data.get(), size}; }
 };
 DecodedBricks decode_bricks(const NarrowBand& band);
+// Which part of the box a gather fills: all of it, or the star (the brick and the parts of its
+// six face neighbours: what lines along the axes through the brick's voxels read, 61% of a
+// 14^3 box). Outside the star the values are left as they were and the active rows read 0.
+enum class GatherRegion { Box, Star };
 // gather_box from decode_bricks(band): the same output, by row copies.
 void gather_box(const NarrowBand& band, std::span<const float> decoded, const Neighborhood& around, int lo, int hi,
-                std::span<float> out, std::span<std::uint32_t> active_rows);
+                std::span<float> out, std::span<std::uint32_t> active_rows, GatherRegion region = GatherRegion::Box);
 
 // Writes tile values back to the active voxels of the brick (inactive voxels untouched,
 // signs of active voxels updated). tile is laid out with the given halo.

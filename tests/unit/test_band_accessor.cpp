@@ -104,6 +104,21 @@ TEST_P(TileTest, GatherMatchesAccessorIncludingHalo) {
     gather_box(band, decoded, brick_neighborhood(band, b), -halo, kBrickDim + halo, tile3, rows3);
     ASSERT_EQ(tile, tile3) << "brick " << b;
     ASSERT_EQ(rows, rows3) << "brick " << b;
+    // The star only: the same values and rows where at most one coordinate leaves the brick,
+    // no active bit elsewhere (the values there are left as they were: a sentinel).
+    std::fill(tile3.begin(), tile3.end(), 1234.5f);
+    gather_box(band, decoded, brick_neighborhood(band, b), -halo, kBrickDim + halo, tile3, rows3, GatherRegion::Star);
+    for (int z = -halo; z < kBrickDim + halo; ++z)
+      for (int y = -halo; y < kBrickDim + halo; ++y)
+        for (int x = -halo; x < kBrickDim + halo; ++x) {
+          auto out = [](int c) { return c < 0 || c >= kBrickDim; };
+          const bool star = int(out(x)) + int(out(y)) + int(out(z)) <= 1;
+          const std::size_t i = shape.index(x, y, z);
+          const std::uint32_t bit = (rows3[std::size_t(y + halo) + dim * std::size_t(z + halo)] >> (x + halo)) & 1u;
+          const std::uint32_t full = (rows[std::size_t(y + halo) + dim * std::size_t(z + halo)] >> (x + halo)) & 1u;
+          ASSERT_EQ(tile3[i], star ? tile[i] : 1234.5f) << "brick " << b << " at " << x << "," << y << "," << z;
+          ASSERT_EQ(bit, star ? full : 0u) << "brick " << b << " at " << x << "," << y << "," << z;
+        }
     const Coord o = brick_origin(band.bricks()[b].coord);
     for (int z = -halo; z < kBrickDim + halo; ++z)
       for (int y = -halo; y < kBrickDim + halo; ++y)
