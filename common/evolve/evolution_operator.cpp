@@ -475,8 +475,8 @@ void brick_operator(const NarrowBand& band, std::span<const float> decoded, std:
   const double h = band.voxel_size();
   const Brick& br = band.bricks()[b];
   const std::size_t first = br.value_offset;
-  const Neighborhood around = brick_neighborhood(band, b);
   // Without the per-voxel pass only the axis lines read the tile: the star is enough.
+  const Neighborhood around = plan.voxel_pass ? brick_neighborhood(band, b) : brick_star(band, b);
   gather_box(band, decoded, around, kLo, kHi, s.tile, s.rows, plan.voxel_pass ? GatherRegion::Box : GatherRegion::Star);
   if (plan.voxel_pass) stencil_rows(s);
   if (plan.upwind) {

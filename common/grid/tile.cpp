@@ -60,6 +60,18 @@ Neighborhood brick_neighborhood(const NarrowBand& band, std::uint32_t brick) {
   return n;
 }
 
+Neighborhood brick_star(const NarrowBand& band, std::uint32_t brick) {
+  Neighborhood n;
+  n.fill(kNoBrick);
+  n[Neighborhood::slot(0, 0, 0)] = brick;
+  for (int f = 0; f < 6; ++f) {
+    Coord d{0, 0, 0};
+    d[f >> 1] = (f & 1) ? 1 : -1;
+    n[std::size_t(Neighborhood::slot(d.x, d.y, d.z))] = band.neighbor(brick, Face(f));
+  }
+  return n;
+}
+
 void decode_brick(const NarrowBand& band, std::uint32_t brick, std::span<float, kBrickVoxels> out) {
   const Brick& br = band.bricks()[brick];
   const float bg = band.background();

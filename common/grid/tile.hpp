@@ -44,6 +44,10 @@ struct Neighborhood : std::array<std::uint32_t, 27> {
   static constexpr Coord offset(int k) { return {k % 3 - 1, (k / 3) % 3 - 1, k / 9 - 1}; }
 };
 Neighborhood brick_neighborhood(const NarrowBand& band, std::uint32_t brick);
+// The brick and its six face neighbours only (face links; the other slots kNoBrick): enough
+// for a GatherRegion::Star gather, which reads no other slot except to take an unallocated
+// face neighbour's sign, and then falls back to the band's row rule.
+Neighborhood brick_star(const NarrowBand& band, std::uint32_t brick);
 
 // The general form: the box [lo, hi)^3 of brick-local voxel coordinates (-8 <= lo <= 0,
 // 8 <= hi <= 16; dim = hi - lo), index (x-lo) + dim*((y-lo) + dim*(z-lo)); active_rows may be
