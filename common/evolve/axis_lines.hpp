@@ -8,18 +8,20 @@
 //   Lines of samples along each axis through the brick's voxels, with the samples beyond the
 //   band's edge (which hold +-W h, not values of the field) replaced by extrapolation from the
 //   active samples of the line (quadratic through the last three, linear through two), up to
-//   `reach` samples from them, so that upwind stencils near the edge see a smooth field.
-//   line(a, i, j)[k] is the sample at coordinate k + kLo along axis a (k in [0, kDim)), at
-//   (i, j) in [0, 8)^2 across (for a = 0: (y, z); 1: (x, z); 2: (x, y)).  Only lines through
-//   at least one active brick voxel are filled.
+//   `reach` samples from them, so that upwind stencils near the edge see a smooth field. Only
+//   the samples a stencil of half-width `reach` around an active brick voxel reads are
+//   extrapolated (the others keep the tile's value). line(a, i, j)[k] is the sample at
+//   coordinate k + kLo along axis a (k in [0, kDim)), at (i, j) in [0, 8)^2 across (for a = 0:
+//   (y, z); 1: (x, z); 2: (x, y)). Only lines through at least one active brick voxel are
+//   filled.
 // upwind_sides(lines, active, scheme, want, sides)
 //   D-u and D+u (value units per voxel) along each axis at the brick's active voxels, for the
 //   axes and sides `want` asks for: the lines' samples around each voxel are gathered, then
 //   one_sided_batch evaluates them all (vector code, bit for bit one_side).
 //   sides.at(a, k) is the pair at the k-th active voxel; sides not wanted are left as they were.
 // Cost: O(3 * 64 * kDim) copies per brick plus the extrapolated gaps; upwind_sides 7 copies
-//   and about 60 flops per active voxel, axis and side (WENO5, vector). No allocation. Threading: pure functions
-//   over caller-owned buffers (one per thread).
+//   and about 60 flops per active voxel, axis and side (WENO5, vector). No allocation.
+//   Threading: pure functions over caller-owned buffers (one per thread).
 // Internal to levelset_core (namespace evolve::detail).
 #pragma once
 
