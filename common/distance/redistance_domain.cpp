@@ -157,9 +157,10 @@ RedistanceDomain build_domain(const NarrowBand& in, int grow, const ProgressHook
   w.source.resize(n);
   w.fixed.assign(n, BrickMask{});
   w.inside.resize(n);
-  w.dist.assign(n * kBrickVoxels, kInf);
+  w.dist.resize(n * kBrickVoxels);  // uninitialised: each brick's part is filled below, in parallel
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 32), [&](const tbb::blocked_range<std::size_t>& r) {
     for (std::size_t b = r.begin(); b != r.end(); ++b) {
+      std::fill_n(w.values(std::uint32_t(b)), kBrickVoxels, kInf);
       const Coord c = set.coords[b];
       for (int f = 0; f < 6; ++f) w.nbr[b][f] = set.find(c + unit(f >> 1, (f & 1) ? 1 : -1));
       const std::uint32_t src = grow == 0 ? std::uint32_t(b) : in.find_brick(c);

@@ -27,6 +27,7 @@
 #include <vector>
 
 #include "core/progress.hpp"
+#include "core/uninitialized_vector.hpp"
 #include "distance/eikonal_update.hpp"
 #include "grid/narrow_band.hpp"
 
@@ -42,7 +43,7 @@ struct RedistanceDomain {
   std::vector<BrickMask> domain;                  // voxels to compute
   std::vector<BrickMask> fixed;                   // interface voxels (never updated)
   std::vector<BrickMask> inside;                  // input sign of every voxel
-  std::vector<float> dist;                        // 512 per brick; +inf = unknown
+  UninitializedVector<float> dist;                // 512 per brick; +inf = unknown (filled in parallel)
 
   std::size_t size() const { return coords.size(); }
   float* values(std::uint32_t b) { return dist.data() + std::size_t(b) * kBrickVoxels; }
