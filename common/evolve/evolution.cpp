@@ -151,7 +151,7 @@ Advanced advance(NarrowBand& cur, const OperatorOutput& op, const OperatorSetup&
       OperatorOutput o1 = run_operator(cur, s2);
       cur.swap_values(next);  // back: next holds u1
       add_phases(result, o1);
-      const std::vector<float> r1 = std::move(o1.rate);
+      const UninitializedVector<float> r1 = std::move(o1.rate);
       result.seconds.operator_eval += since(t2);
       std::vector<float> u2(next.size());
       for_each_value(next.size(), [&](std::size_t i) {
@@ -163,7 +163,7 @@ Advanced advance(NarrowBand& cur, const OperatorOutput& op, const OperatorSetup&
       OperatorOutput o2 = run_operator(cur, s2);
       cur.swap_values(u2);  // back
       add_phases(result, o2);
-      const std::vector<float> r2 = std::move(o2.rate);
+      const UninitializedVector<float> r2 = std::move(o2.rate);
       result.seconds.operator_eval += since(t2);
       finish_stage(u0, op.edge, next,
                    [&](std::size_t i) { return float(u0[i] / 3.0 + 2.0 / 3.0 * (double(u2[i]) + dt * double(r2[i]))); },

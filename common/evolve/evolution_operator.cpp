@@ -546,7 +546,7 @@ OperatorOutput run_operator(const NarrowBand& band, const OperatorSetup& setup) 
   out.min_value = std::numeric_limits<float>::infinity();
   out.max_value = -std::numeric_limits<float>::infinity();
   const std::size_t n = band.active_voxel_count();
-  out.rate.assign(n, 0.0f);
+  out.rate.resize(n);  // uninitialised: brick_operator writes every active voxel's rate
   if (setup.want_betas) {
     out.beta_a.assign(n, 0.0f);
     out.beta_p.assign(n, 0.0f);

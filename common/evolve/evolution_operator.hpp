@@ -21,6 +21,7 @@
 #include <limits>
 #include <vector>
 
+#include "core/uninitialized_vector.hpp"
 #include "evolve/evolution.hpp"
 #include "grid/narrow_band.hpp"
 
@@ -58,7 +59,8 @@ struct OperatorSetup {
 };
 
 struct OperatorOutput {
-  std::vector<float> rate, beta_a, beta_p;
+  UninitializedVector<float> rate;  // every active voxel's entry is written
+  std::vector<float> beta_a, beta_p;
   std::vector<std::uint8_t> edge;  // 1: an active voxel with an inactive 6-neighbour
   std::vector<std::vector<EdgeStencil>> edge_stencils;  // per brick
   double max_hyperbolic = 0, max_speed = 0, max_front_speed = 0, drift_sum = 0;
