@@ -14,8 +14,8 @@
 //   floating-point expansion arithmetic (error-free two_sum / fma two_product), which is exact.
 // Assumptions: no overflow or underflow in the intermediate products (coordinates between
 //   about 1e-100 and 1e100 in magnitude, or zero).
-// Cost: the filtered path is ~20 (2D) / ~40 (3D) flops; the exact path allocates and costs a
-//   few microseconds, and runs only for (nearly) degenerate inputs.
+// Cost: the filtered path is ~20 (2D) / ~40 (3D) flops; the exact path works on the stack
+//   (no allocation) and costs well under a microsecond, and runs only for (nearly) degenerate inputs.
 // Threading: pure functions. Errors: none (non-finite inputs give an unspecified sign).
 #pragma once
 

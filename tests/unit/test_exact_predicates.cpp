@@ -81,6 +81,52 @@ TEST(ExactPredicates, Orient3dMatchesRationalsOnNearlyCoplanarPoints) {
   EXPECT_GT(naive_wrong, 50);
 }
 
+// Marching-cubes meshes re-sampled at their own resolution: vertices lie on grid lines (two
+// integer coordinates, the third a fraction), probed from integer voxel centres. Most tests
+// are exact ties or decided in the last bits: the stack expansions must match rationals.
+TEST(ExactPredicates, GridAlignedInputsMatchRationals) {
+  std::mt19937_64 rng(13);
+  std::uniform_int_distribution<int> I(0, 6);
+  std::uniform_real_distribution<double> F(0.0, 1.0);
+  auto on_grid_line = [&] {
+    Vec3d v{double(I(rng)), double(I(rng)), double(I(rng))};
+    v[int(rng() % 3)] += (rng() % 3 == 0) ? 0.5 : F(rng);  // exact midpoints, and arbitrary
+    return v;
+  };
+  int zeros2 = 0, zeros3 = 0;
+  for (int i = 0; i < 20000; ++i) {
+    const Vec3d a = on_grid_line(), b = on_grid_line(), c = on_grid_line();
+    const Vec3d p{double(I(rng)), double(I(rng)), double(I(rng))};
+    const int ref2 = reference_orient2d(a.x, a.y, b.x, b.y, p.x, p.y);
+    ASSERT_EQ(orient2d_exact(a.x, a.y, b.x, b.y, p.x, p.y), ref2) << i;
+    ASSERT_EQ(orient2d_sign(a.x, a.y, b.x, b.y, p.x, p.y), ref2) << i;
+    const int ref3 = reference_orient3d(a, b, c, p);
+    ASSERT_EQ(orient3d_exact(a, b, c, p), ref3) << i;
+    ASSERT_EQ(orient3d_sign(a, b, c, p), ref3) << i;
+    zeros2 += ref2 == 0;
+    zeros3 += ref3 == 0;
+  }
+  EXPECT_GT(zeros2, 500);
+  EXPECT_GT(zeros3, 40);
+}
+
+// Many-component expansions: coordinates spread over 2^-60 .. 2^60 make every difference
+// and product inexact, so sums of several hundred bits decide the sign.
+TEST(ExactPredicates, WideDynamicRangeMatchesRationals) {
+  std::mt19937_64 rng(14);
+  std::uniform_int_distribution<int> E(-60, 60);
+  std::uniform_real_distribution<double> M(-1.0, 1.0);
+  auto wide = [&] { return std::ldexp(M(rng), E(rng)); };
+  for (int i = 0; i < 3000; ++i) {
+    const Vec3d a{wide(), wide(), wide()}, b{wide(), wide(), wide()}, c{wide(), wide(), wide()};
+    Vec3d d = a + (b - a) * M(rng) + (c - a) * M(rng);  // near the plane, rounded
+    if (i % 3 == 0) d.x = std::nextafter(d.x, 1e300);
+    ASSERT_EQ(orient3d_exact(a, b, c, d), reference_orient3d(a, b, c, d)) << i;
+    ASSERT_EQ(orient2d_exact(a.x, a.y, b.x, b.y, d.x, d.y), reference_orient2d(a.x, a.y, b.x, b.y, d.x, d.y))
+        << i;
+  }
+}
+
 TEST(ExactPredicates, Orient3dSignConvention) {
   // Counterclockwise triangle seen from +z; a point below it (behind) is positive.
   const Vec3d a{0, 0, 0}, b{1, 0, 0}, c{0, 1, 0};
