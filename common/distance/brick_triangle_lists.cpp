@@ -111,6 +111,7 @@ BrickTriangleLists bin_triangles_to_bricks(const TriangleMesh& mesh, const BinTr
   options.progress.step(0.7, "bin");
 
   BrickTriangleLists lists;
+  lists.margin = options.margin;
   lists.triangles.resize(pairs.size());
   lists.offsets.push_back(0);
   for (std::size_t i = 0; i < pairs.size(); ++i) {

@@ -29,6 +29,7 @@ struct BrickTriangleLists {
   std::vector<Coord> bricks;             // sorted by brick_key
   std::vector<std::uint64_t> offsets;    // bricks.size() + 1 entries
   std::vector<std::uint32_t> triangles;  // triangles of brick i: [offsets[i], offsets[i+1])
+  double margin = 0.0;  // world units: every triangle within it of a listed brick is listed
 };
 
 struct BinTrianglesOptions {

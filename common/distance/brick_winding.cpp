@@ -129,7 +129,7 @@ double query(const BrickWindingContext& c, const Coord& brick, int n, std::uint6
   ++queries;
   const Vec3d p =
       c.frame.origin + Vec3d{double(g.x), double(g.y), double(g.z)} * c.frame.voxel_size;
-  return winding_number(c.tree, p, c.beta);
+  return winding_number(c.tree.get(), p, c.beta);
 }
 
 // Does segment [a, b] meet the box [lo, hi] (slab clipping; conservative at the boundary)?
@@ -310,6 +310,18 @@ BrickMask inside_from_reference(std::span<const GridTriangle> triangles,
   for (int n = 0; n < kBrickVoxels; ++n)
     if (w_ref + rel[n] > 0.5) inside.set(n);
   return inside;
+}
+
+std::array<int, kBrickVoxels> relative_winding(std::span<const GridTriangle> triangles,
+                                               std::span<const std::uint32_t> ids,
+                                               const Coord& brick, BrickCrossings& x) {
+  x = BrickCrossings{};
+  LineSet lines{1, 0, ~0ull};  // x: the line (y, z) = (0, 0); y: the lines (z, x) = (0, i)
+  for (int i = 0; i < kBrickDim; ++i) lines[1] |= std::uint64_t{1} << (8 * i);
+  brick_crossings(triangles, ids, brick, lines, x);
+  std::array<int, kBrickVoxels> rel;
+  propagate(x, Coord{0, 0, 0}, Coord{0, 0, 0}, kBrickDim, rel.data());
+  return rel;
 }
 
 BrickMask inside_adaptive(const BrickCrossings& crossings, const Coord& brick,

@@ -24,6 +24,12 @@
 //   elephant-with-holes (1353 open edges) at 512^3: 114 queries per brick on average; all
 //   voxels with |w - 1/2| > 0.1 agree with a direct query, 0.006% of those closer do not.
 // Output of both: bit n set when w > 1/2; queries counts the tree evaluations made.
+// relative_winding
+//   For closed meshes (every edge's uses cancel), with no query: every voxel's winding number
+//   minus that of the brick's base voxel (local 0, 0, 0), summing the jumps along the path
+//   base -> along x -> along y -> along z (the base's x-line, the y-lines of its z-slice, all
+//   64 z-lines). Exact (path independent for closed meshes); rel[local_index(7 e_a)] is the
+//   change along the base's line on axis a.
 // Threading: pure; call concurrently for different bricks. Errors: none.
 #pragma once
 
@@ -42,7 +48,7 @@ namespace levelset {
 inline constexpr double kAdaptiveTolerance = 0.1;
 
 struct BrickWindingContext {
-  const WindingNumberTree& tree;
+  const LazyWindingTree& tree;
   const GridFrame& frame;
   double beta = 2.0;
 };
@@ -52,6 +58,11 @@ BrickMask inside_from_reference(std::span<const GridTriangle> triangles,
                                 std::span<const std::uint32_t> ids, const Coord& brick,
                                 const BrickWindingContext& context, BrickCrossings& scratch,
                                 std::uint64_t& queries);
+
+// Computes the crossings it needs into `scratch`.
+std::array<int, kBrickVoxels> relative_winding(std::span<const GridTriangle> triangles,
+                                               std::span<const std::uint32_t> ids,
+                                               const Coord& brick, BrickCrossings& scratch);
 
 // `crossings`: all lines (kAllLines).
 

@@ -48,7 +48,10 @@ Adjacency build_adjacency(const TriangleMesh& mesh) {
   });
   adj.across.assign(3 * nt, kNoTriangle);
   adj.first_triangle.assign(nv, kNoTriangle);
-  std::vector<std::vector<std::uint32_t>> ring(nv);
+  // Distinct edges (first use of each run); the rings in CSR form, each vertex's neighbours in
+  // the order of the sorted edges (ascending).
+  std::vector<std::size_t> edge_starts;
+  adj.ring_offsets.assign(nv + 1, 0);
   for (std::size_t i = 0; i < uses.size();) {
     std::size_t j = i;
     while (j < uses.size() && uses[j].lo == uses[i].lo && uses[j].hi == uses[i].hi) ++j;
@@ -58,8 +61,9 @@ Adjacency build_adjacency(const TriangleMesh& mesh) {
     }
     if (uses[i].lo != uses[i].hi && (j - i) % 2 == 1) ++adj.odd_edges;
     if (uses[i].lo != uses[i].hi) {
-      ring[uses[i].lo].push_back(uses[i].hi);
-      ring[uses[i].hi].push_back(uses[i].lo);
+      edge_starts.push_back(i);
+      ++adj.ring_offsets[uses[i].lo + 1];
+      ++adj.ring_offsets[uses[i].hi + 1];
     }
     i = j;
   }
@@ -68,10 +72,13 @@ Adjacency build_adjacency(const TriangleMesh& mesh) {
       std::uint32_t& first = adj.first_triangle[adj.welded[mesh.triangles[t][k]]];
       first = std::min(first, std::uint32_t(t));
     }
-  adj.ring_offsets.assign(nv + 1, 0);
-  for (std::size_t v = 0; v < nv; ++v) adj.ring_offsets[v + 1] = adj.ring_offsets[v] + std::uint32_t(ring[v].size());
-  adj.ring_vertices.reserve(adj.ring_offsets[nv]);
-  for (std::size_t v = 0; v < nv; ++v) adj.ring_vertices.insert(adj.ring_vertices.end(), ring[v].begin(), ring[v].end());
+  for (std::size_t v = 0; v < nv; ++v) adj.ring_offsets[v + 1] += adj.ring_offsets[v];
+  adj.ring_vertices.resize(adj.ring_offsets[nv]);
+  std::vector<std::uint32_t> fill(adj.ring_offsets.begin(), adj.ring_offsets.end() - 1);
+  for (std::size_t i : edge_starts) {
+    adj.ring_vertices[fill[uses[i].lo]++] = uses[i].hi;
+    adj.ring_vertices[fill[uses[i].hi]++] = uses[i].lo;
+  }
   return adj;
 }
 
@@ -109,8 +116,11 @@ Vec3d unit(const Vec3d& v) {
 // floats order like their bits, so the minimum is the nearest triangle, ties to the lowest.
 class MinField {
  public:
+  // Cells set to empty in parallel (first touch of the pages spread over the threads).
   explicit MinField(const BrickSet& set) : set_(set), cells_(set.bricks.size() * std::size_t(kBrickVoxels)) {
-    for (auto& c : cells_) c.store(kEmpty, std::memory_order_relaxed);
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, cells_.size(), 1 << 14), [&](const auto& r) {
+      for (std::size_t i = r.begin(); i != r.end(); ++i) cells_[i].store(kEmpty, std::memory_order_relaxed);
+    });
   }
   static constexpr std::uint64_t kEmpty = ~std::uint64_t{0};
 
@@ -436,13 +446,15 @@ CharacteristicScanResult characteristic_scan(const TriangleMesh& mesh, const std
   result.odd_edges = adj.odd_edges;
   ClosestTriangleField& out = result.field;
   out.bricks = set.bricks;
-  out.distance.assign(field.size(), std::numeric_limits<float>::infinity());
-  out.owner.assign(field.size(), kNoTriangle);
-  tbb::parallel_for(std::size_t(0), field.size(), [&](std::size_t i) {
-    const std::uint64_t value = field.load(i);
-    if (value == MinField::kEmpty) return;
-    out.distance[i] = std::bit_cast<float>(std::uint32_t(value >> 32));
-    out.owner[i] = std::uint32_t(value);
+  out.distance.resize(field.size());  // every cell written below
+  out.owner.resize(field.size());
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, field.size(), 1 << 14), [&](const auto& r) {
+    for (std::size_t i = r.begin(); i != r.end(); ++i) {
+      const std::uint64_t value = field.load(i);
+      const bool empty = value == MinField::kEmpty;
+      out.distance[i] = empty ? std::numeric_limits<float>::infinity() : std::bit_cast<float>(std::uint32_t(value >> 32));
+      out.owner[i] = empty ? kNoTriangle : std::uint32_t(value);
+    }
   });
   return result;
 }

@@ -29,6 +29,7 @@
 #include <vector>
 
 #include "core/progress.hpp"
+#include "core/uninitialized_vector.hpp"
 #include "grid/narrow_band.hpp"
 #include "io/triangle_mesh.hpp"
 
@@ -39,8 +40,8 @@ inline constexpr std::uint32_t kNoTriangle = 0xffffffffu;
 // Per-voxel unsigned distance and closest triangle over a sorted set of bricks.
 struct ClosestTriangleField {
   std::vector<Coord> bricks;         // sorted by brick_key
-  std::vector<float> distance;       // bricks.size() * kBrickVoxels; +inf: not in the band
-  std::vector<std::uint32_t> owner;  // closest triangle per voxel, or kNoTriangle
+  UninitializedVector<float> distance;       // bricks.size() * kBrickVoxels; +inf: not in the band
+  UninitializedVector<std::uint32_t> owner;  // closest triangle per voxel, or kNoTriangle
 };
 
 struct CharacteristicScanOptions {

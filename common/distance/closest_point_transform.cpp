@@ -7,6 +7,7 @@
 #include <string>
 
 #include <tbb/parallel_for.h>
+#include <tbb/task_group.h>
 
 #include "core/error.hpp"
 #include "core/text.hpp"
@@ -154,6 +155,7 @@ ClosestTriangleField slab_scan(const TriangleMesh& mesh, const BrickTriangleList
 // bricks beyond the shell: no triangle meets them). Both inputs are sorted by key.
 BrickTriangleLists band_brick_lists(const ClosestTriangleField& field, const BrickTriangleLists& lists) {
   BrickTriangleLists out;
+  out.margin = lists.margin;
   out.offsets.push_back(0);
   std::size_t j = 0;
   for (std::size_t i = 0; i < field.bricks.size(); ++i) {
@@ -230,14 +232,29 @@ CptResult closest_point_transform(const TriangleMesh& mesh, const CptOptions& op
   CptResult result;
   result.triangles = mesh.triangles.size();
 
-  auto t = Clock::now();
   // Sign mesh: every face once, then consistently oriented (distances use the mesh as given).
-  const OrientResult oriented = orient_faces(unique_faces(mesh).mesh, OrientOptions{});
-  result.faces_flipped = oriented.faces_flipped;
-  result.seconds.orient = since(t);
-  options.progress.step(0.05, "orient");
+  // Mostly serial sorts and a walk, so it runs beside the binning and the scan, which fill the
+  // other threads; the signs wait for it.
+  OrientResult oriented;
+  tbb::task_group orienting;
+  orienting.run([&] {
+    const auto t0 = Clock::now();
+    oriented = orient_faces(unique_faces(mesh).mesh, OrientOptions{});
+    result.seconds.orient = since(t0);
+  });
+  // Joins the orientation task on every exit; after an error or a cancel in the scan, the
+  // scan's exception is the one that propagates.
+  struct Join {
+    tbb::task_group& group;
+    ~Join() {
+      try {
+        group.wait();
+      } catch (...) {
+      }
+    }
+  } join{orienting};
 
-  t = Clock::now();
+  auto t = Clock::now();
   const CptMethod method =
       options.method == CptMethod::automatic ? choose_method(mesh, options.frame) : options.method;
   result.method = method;
@@ -273,11 +290,15 @@ CptResult closest_point_transform(const TriangleMesh& mesh, const CptOptions& op
   result.seconds.distance = since(t);
   options.progress.step(0.7, "distance");
 
+  orienting.wait();
+  result.faces_flipped = oriented.faces_flipped;
+
   // Signs: winding numbers of the consistently oriented mesh, one mask per brick, over the
   // band's bricks with their triangles (the masks need every triangle meeting a brick; those
   // are all within the lists' margin).
   t = Clock::now();
-  const WindingNumberTree tree = build_winding_tree(oriented.mesh);
+  // Built only if needed: closed meshes get exact signs from rays and jumps alone.
+  const LazyWindingTree tree(oriented.mesh);
   InsideMasksOptions sign_options;
   sign_options.frame = options.frame;
   sign_options.progress = options.progress;
@@ -298,6 +319,7 @@ CptResult closest_point_transform(const TriangleMesh& mesh, const CptOptions& op
     signs = compute_inside_masks(oriented.mesh, tree, sign_lists, sign_options);
   }
   result.winding_queries = signs.winding_queries;
+  result.ray_queries = signs.ray_queries;
   result.open_edges = signs.open_edges;
   const std::size_t nb = sign_lists.bricks.size();
   std::vector<MembraneBrick> per_brick = pack_bricks(mesh, field, sign_lists, options);
@@ -316,7 +338,7 @@ CptResult closest_point_transform(const TriangleMesh& mesh, const CptOptions& op
     membrane.search_bounds = oriented.mesh.bounds();
     membrane.closest_points = options.closest_points;
     membrane.progress = options.progress;
-    const MembraneResult closed = close_membranes(tree, per_brick, membrane);
+    const MembraneResult closed = close_membranes(tree.get(), per_brick, membrane);
     result.membrane_voxels = closed.membrane_voxels;
     result.membrane_bricks_added = closed.bricks_added;
     result.membrane_voxels_added = closed.voxels_added;

@@ -26,8 +26,9 @@
 //   coarse meshes (options.method chooses; automatic by a cost estimate). Ties: lowest
 //   triangle index. No per-voxel loop over all triangles. Sign: faces are oriented
 //   consistently (orient_faces), then every voxel of every brick gets the generalized winding
-//   number test (> 1/2 is inside) from one hierarchical evaluation per brick plus signed
-//   crossings along grid edges (compute_inside_masks) — robust for holes, open boundaries,
+//   number test (> 1/2 is inside) from signed crossings along grid edges plus, for closed
+//   meshes, one exact ray per connected group of bricks, otherwise one hierarchical
+//   evaluation per brick (compute_inside_masks) — robust for holes, open boundaries,
 //   self-intersections and flipped faces (thesis open issue 5.3). Then, for open meshes only,
 //   the membranes (membrane_band.hpp).
 // Cost: characteristic: O(band voxels + triangles * columns per polyhedron); slab scan:
@@ -75,7 +76,8 @@ struct CptResult {
   std::uint64_t polyhedra = 0;              // characteristic polyhedra scanned
   std::uint64_t evaluations = 0;            // ... and their point-triangle distances
   std::uint64_t faces_flipped = 0;  // by the orientation pass
-  std::uint64_t winding_queries = 0;
+  std::uint64_t winding_queries = 0;  // tree evaluations (open meshes)
+  std::uint64_t ray_queries = 0;      // exact ray winding numbers (closed meshes)
   std::uint64_t open_edges = 0;                 // of the oriented sign mesh (0: closed)
   std::uint64_t membrane_voxels = 0;            // ends of sign changes across holes
   std::uint64_t membrane_bricks_added = 0;      // bricks beyond the mesh's band

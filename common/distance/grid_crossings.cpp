@@ -75,6 +75,38 @@ inline int side(const Hit& h, double m, bool& on_plane) {
   return h.tie;
 }
 
+
+// The triangle's corners in the (u, v, w) frame of axis w, with its tie sign.
+inline Hit axis_frame(const GridTriangle& t, int w) {
+  const int u = (w + 1) % 3, v = (w + 2) % 3;
+  Hit h;
+  h.a = {t.corner[0][u], t.corner[0][v], t.corner[0][w]};
+  h.b = {t.corner[1][u], t.corner[1][v], t.corner[1][w]};
+  h.c = {t.corner[2][u], t.corner[2][v], t.corner[2][w]};
+  h.tie = t.normal_sign[0] != 0 ? t.normal_sign[0]
+                                : (t.normal_sign[1] != 0 ? t.normal_sign[1] : t.normal_sign[2]);
+  return h;
+}
+
+// Does the perturbed line (pu, pv) along w hit the triangle (its projection, normal sign
+// sigma != 0)? Fills the edge values `side` needs.
+inline bool line_hits(Hit& h, double pu, double pv, int sigma, bool u_first) {
+  h.pu = pu;
+  h.pv = pv;
+  h.eab = edge_value(h.a.x, h.a.y, h.b.x, h.b.y, pu, pv, u_first);
+  if (h.eab.sign != sigma) return false;
+  h.ebc = edge_value(h.b.x, h.b.y, h.c.x, h.c.y, pu, pv, u_first);
+  if (h.ebc.sign != sigma) return false;
+  h.eca = edge_value(h.c.x, h.c.y, h.a.x, h.a.y, pu, pv, u_first);
+  return h.eca.sign == sigma;
+}
+
+// Is (pu, pv) inside the triangle's projected bounding box (inclusive)?
+inline bool in_projected_box(const Hit& h, double pu, double pv) {
+  return pu >= std::min({h.a.x, h.b.x, h.c.x}) && pu <= std::max({h.a.x, h.b.x, h.c.x}) &&
+         pv >= std::min({h.a.y, h.b.y, h.c.y}) && pv <= std::max({h.a.y, h.b.y, h.c.y});
+}
+
 }  // namespace
 
 std::vector<Vec3d> to_grid_vertices(const TriangleMesh& mesh, const GridFrame& frame) {
@@ -123,20 +155,13 @@ void brick_crossings(std::span<const GridTriangle> triangles, std::span<const st
       }
       if (misses) continue;
     }
-    const int tie3 = t.normal_sign[0] != 0
-                         ? t.normal_sign[0]
-                         : (t.normal_sign[1] != 0 ? t.normal_sign[1] : t.normal_sign[2]);
     for (int w = 0; w < 3; ++w) {
       const int sigma = t.normal_sign[w];
       if (sigma == 0 || lines[w] == 0) continue;
       const int u = (w + 1) % 3, v = (w + 2) % 3;
       // Global x > y > z infinitesimal order, seen in this axis's (u, v) plane.
       const bool u_first = w != 1;
-      Hit h;
-      h.a = {t.corner[0][u], t.corner[0][v], t.corner[0][w]};
-      h.b = {t.corner[1][u], t.corner[1][v], t.corner[1][w]};
-      h.c = {t.corner[2][u], t.corner[2][v], t.corner[2][w]};
-      h.tie = tie3;
+      Hit h = axis_frame(t, w);
       const double wlo = double(o[w]), whi = double(o[w] + kBrickDim - 1);
       if (std::max({h.a.z, h.b.z, h.c.z}) < wlo || std::min({h.a.z, h.b.z, h.c.z}) > whi) continue;
       // Lines of this brick inside the projected bounding box.
@@ -150,16 +175,9 @@ void brick_crossings(std::span<const GridTriangle> triangles, std::span<const st
       const int ju0 = int(umin) - o[u], ju1 = int(umax) - o[u];
       const int jv0 = int(vmin) - o[v], jv1 = int(vmax) - o[v];
       for (int jv = jv0; jv <= jv1; ++jv) {
-        h.pv = double(o[v] + jv);
         for (int ju = ju0; ju <= ju1; ++ju) {
           if (!((lines[w] >> (ju + 8 * jv)) & 1u)) continue;
-          h.pu = double(o[u] + ju);
-          h.eab = edge_value(h.a.x, h.a.y, h.b.x, h.b.y, h.pu, h.pv, u_first);
-          if (h.eab.sign != sigma) continue;
-          h.ebc = edge_value(h.b.x, h.b.y, h.c.x, h.c.y, h.pu, h.pv, u_first);
-          if (h.ebc.sign != sigma) continue;
-          h.eca = edge_value(h.c.x, h.c.y, h.a.x, h.a.y, h.pu, h.pv, u_first);
-          if (h.eca.sign != sigma) continue;
+          if (!line_hits(h, double(o[u] + ju), double(o[v] + jv), sigma, u_first)) continue;
           // Centre m is before the crossing (going +w) when side(m) == sigma. Every probed
           // centre found exactly on the plane lies on the triangle (the line hits it there).
           std::uint8_t on = 0;  // bit e: local centre e exactly on the triangle
@@ -211,6 +229,50 @@ void brick_crossings(std::span<const GridTriangle> triangles, std::span<const st
       }
     }
   }
+}
+
+int edge_jump(std::span<const GridTriangle> triangles, std::span<const std::uint32_t> ids_a,
+              std::span<const std::uint32_t> ids_b, const Coord& voxel, int w) {
+  const int u = (w + 1) % 3, v = (w + 2) % 3;
+  const bool u_first = w != 1;
+  const double pu = voxel[u], pv = voxel[v], m = voxel[w];
+  int jump = 0;
+  auto add = [&](std::uint32_t id) {
+    const GridTriangle& t = triangles[id];
+    const int sigma = t.normal_sign[w];
+    if (sigma == 0) return;
+    Hit h = axis_frame(t, w);
+    if (std::max({h.a.z, h.b.z, h.c.z}) < m || std::min({h.a.z, h.b.z, h.c.z}) > m + 1.0) return;
+    if (!in_projected_box(h, pu, pv) || !line_hits(h, pu, pv, sigma, u_first)) return;
+    bool on_plane = false;
+    if (side(h, m, on_plane) == sigma && side(h, m + 1.0, on_plane) != sigma) jump -= sigma;
+  };
+  // Both lists are sorted: walk them as one set (a triangle in both counts once).
+  std::size_t i = 0, j = 0;
+  while (i < ids_a.size() || j < ids_b.size()) {
+    if (j == ids_b.size() || (i < ids_a.size() && ids_a[i] < ids_b[j])) {
+      add(ids_a[i++]);
+    } else {
+      if (i < ids_a.size() && ids_a[i] == ids_b[j]) ++i;
+      add(ids_b[j++]);
+    }
+  }
+  return jump;
+}
+
+int ray_winding(std::span<const GridTriangle> triangles, const Coord& voxel) {
+  const double pu = voxel.y, pv = voxel.z, m = voxel.x;
+  int winding = 0;
+  for (const GridTriangle& t : triangles) {
+    const int sigma = t.normal_sign[0];
+    if (sigma == 0) continue;
+    if (std::max({t.corner[0].x, t.corner[1].x, t.corner[2].x}) < m) continue;
+    Hit h = axis_frame(t, 0);
+    if (!in_projected_box(h, pu, pv) || !line_hits(h, pu, pv, sigma, true)) continue;
+    bool on_plane = false;
+    if (side(h, m, on_plane) == sigma) winding += sigma;
+  }
+  return winding;
 }
 
 }  // namespace levelset

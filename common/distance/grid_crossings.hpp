@@ -71,4 +71,16 @@ inline constexpr LineSet kAllLines{~0ull, ~0ull, ~0ull};
 void brick_crossings(std::span<const GridTriangle> triangles, std::span<const std::uint32_t> ids,
                      const Coord& brick, const LineSet& lines, BrickCrossings& out);
 
+// The winding jump from global voxel `voxel` to voxel + e_w (the same value brick_crossings
+// gives that edge), over the triangles in ids_a and ids_b (each sorted; their union is used,
+// so the lists of the two bricks the edge joins hold every triangle crossing it when their
+// margin is at least half a voxel). Cost: O(|ids_a| + |ids_b|) box tests.
+int edge_jump(std::span<const GridTriangle> triangles, std::span<const std::uint32_t> ids_a,
+              std::span<const std::uint32_t> ids_b, const Coord& voxel, int w);
+
+// The exact winding number of the perturbed voxel centre for a closed mesh (every edge's uses
+// cancel): the signed crossings of all triangles with the ray from it along +x (w = 0 beyond
+// the mesh). Cost: O(triangles) box tests. Threading: pure.
+int ray_winding(std::span<const GridTriangle> triangles, const Coord& voxel);
+
 }  // namespace levelset

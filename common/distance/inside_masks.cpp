@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <optional>
 #include <span>
 #include <string>
 
@@ -113,7 +114,7 @@ void gather_rims(const BrickTriangleLists& lists, std::size_t i, std::span<const
   }
 }
 
-void validate(const TriangleMesh& mesh, const WindingNumberTree& tree,
+void validate(const TriangleMesh& mesh, const LazyWindingTree& tree,
               const BrickTriangleLists& lists, const InsideMasksOptions& options) {
   const GridFrame& f = options.frame;
   if (!(std::isfinite(f.voxel_size) && f.voxel_size > 0.0) || !isfinite(f.origin))
@@ -123,10 +124,10 @@ void validate(const TriangleMesh& mesh, const WindingNumberTree& tree,
     throw Error(ErrorCode::InvalidArgument, "beta", "must be finite and > 0");
   const std::size_t nt = mesh.triangles.size();
   validate_mesh(mesh);
-  if (tree.order.size() != nt)
+  if (tree.given() && tree.given()->order.size() != nt)
     throw Error(ErrorCode::InvalidArgument, "winding tree",
-                "built from a mesh with " + std::to_string(tree.order.size()) + " triangles, not " +
-                    std::to_string(nt));
+                "built from a mesh with " + std::to_string(tree.given()->order.size()) +
+                    " triangles, not " + std::to_string(nt));
   const std::size_t nb = lists.bricks.size();
   if (lists.offsets.size() != nb + 1 || lists.offsets.front() != 0 ||
       lists.offsets.back() != lists.triangles.size())
@@ -146,10 +147,125 @@ void validate(const TriangleMesh& mesh, const WindingNumberTree& tree,
                   "triangle index " + std::to_string(t) + " out of range");
 }
 
+// Closed meshes (no open edge): exact integer winding numbers without the tree. Per brick, the
+// winding numbers relative to its base voxel (relative_winding) and the changes from its base
+// to the bases of its +x, +y, +z neighbours (the base's line plus the edge across the face);
+// then, per face-connected group of bricks, one ray from a base anchors them all.
+struct RelativeBrick {
+  int lo = 0;                             // lowest relative winding number in the brick
+  std::vector<BrickMask> levels;          // levels[k]: voxels with relative w >= lo + 1 + k
+  std::array<std::size_t, 3> next{};      // index of the +axis neighbour (nb: none)
+  std::array<int, 3> step{};              // w(neighbour's base) - w(base)
+};
+
+RelativeBrick relative_brick(std::span<const GridTriangle> grid, const BrickTriangleLists& lists,
+                             std::size_t i, BrickCrossings& scratch) {
+  auto ids = [&](std::size_t k) {
+    return std::span<const std::uint32_t>(lists.triangles.data() + lists.offsets[k],
+                                          lists.offsets[k + 1] - lists.offsets[k]);
+  };
+  const std::size_t nb = lists.bricks.size();
+  const Coord& brick = lists.bricks[i];
+  const std::array<int, kBrickVoxels> rel = relative_winding(grid, ids(i), brick, scratch);
+  RelativeBrick out;
+  const auto [lo, hi] = std::minmax_element(rel.begin(), rel.end());
+  out.lo = *lo;
+  out.levels.resize(std::size_t(*hi - *lo));
+  for (int n = 0; n < kBrickVoxels; ++n)
+    for (int k = 0; k < rel[n] - out.lo; ++k) out.levels[std::size_t(k)].set(n);
+  for (int a = 0; a < 3; ++a) {
+    Coord step{0, 0, 0};
+    step[a] = 1;
+    out.next[a] = find_brick(lists, brick + step);
+    if (out.next[a] == nb) continue;
+    Coord last{0, 0, 0};
+    last[a] = kBrickDim - 1;
+    out.step[a] = rel[std::size_t(local_index(last.x, last.y, last.z))] +
+                  edge_jump(grid, ids(i), ids(out.next[a]), brick_origin(brick) + last, a);
+  }
+  return out;
+}
+
+// The masks, or nothing when the rays would cost more than the tree (many separate groups of
+// bricks) or the links disagree (never for a closed mesh: kept as a guard).
+std::optional<std::vector<BrickMask>> closed_masks(std::span<const GridTriangle> grid,
+                                                   const BrickTriangleLists& lists,
+                                                   const InsideMasksOptions& options,
+                                                   std::uint64_t& rays) {
+  const std::size_t nb = lists.bricks.size();
+  std::vector<RelativeBrick> bricks(nb);
+  for (std::size_t start = 0; start < nb; start += kBatchBricks) {
+    const std::size_t end = std::min(nb, start + kBatchBricks);
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(start, end, 4),
+                      [&](const tbb::blocked_range<std::size_t>& range) {
+      options.progress.check("sign");
+      BrickCrossings scratch;
+      for (std::size_t i = range.begin(); i != range.end(); ++i)
+        bricks[i] = relative_brick(grid, lists, i, scratch);
+    });
+    options.progress.step(0.9 * double(end) / double(nb), "sign");
+  }
+  // Face-connected groups, each base relative to its group's first brick.
+  std::vector<std::vector<std::pair<std::size_t, int>>> links(nb);  // (neighbour, w change)
+  for (std::size_t i = 0; i < nb; ++i)
+    for (int a = 0; a < 3; ++a)
+      if (bricks[i].next[a] != nb) {
+        links[i].push_back({bricks[i].next[a], bricks[i].step[a]});
+        links[bricks[i].next[a]].push_back({i, -bricks[i].step[a]});
+      }
+  constexpr std::size_t kNone = ~std::size_t{0};
+  std::vector<std::size_t> group(nb, kNone);
+  std::vector<int> base(nb, 0);
+  std::vector<std::size_t> roots, queue;
+  for (std::size_t r = 0; r < nb; ++r) {
+    if (group[r] != kNone) continue;
+    group[r] = roots.size();
+    roots.push_back(r);
+    queue.assign(1, r);
+    while (!queue.empty()) {
+      const std::size_t i = queue.back();
+      queue.pop_back();
+      for (const auto& [j, change] : links[i]) {
+        if (group[j] != kNone) {
+          if (base[j] != base[i] + change) return std::nullopt;
+          continue;
+        }
+        group[j] = group[i];
+        base[j] = base[i] + change;
+        queue.push_back(j);
+      }
+    }
+  }
+  if (double(roots.size()) * double(grid.size()) > options.max_ray_work) return std::nullopt;
+  std::vector<int> anchor(roots.size());
+  tbb::parallel_for(std::size_t(0), roots.size(), [&](std::size_t g) {
+    anchor[g] = ray_winding(grid, brick_origin(lists.bricks[roots[g]]));
+  });
+  rays = roots.size();
+  std::vector<BrickMask> inside(nb);
+  tbb::parallel_for(std::size_t(0), nb, [&](std::size_t i) {
+    // Inside: w = w(base) + rel >= 1, i.e. rel >= 1 - w(base).
+    const int need = 1 - (anchor[group[i]] + base[i]);
+    const RelativeBrick& b = bricks[i];
+    if (need <= b.lo)
+      inside[i].words.fill(~std::uint64_t{0});
+    else if (need - b.lo <= int(b.levels.size()))
+      inside[i] = b.levels[std::size_t(need - b.lo - 1)];
+  });
+  return inside;
+}
+
 }  // namespace
 
 InsideMasksResult compute_inside_masks(const TriangleMesh& oriented_mesh,
                                        const WindingNumberTree& tree,
+                                       const BrickTriangleLists& lists,
+                                       const InsideMasksOptions& options) {
+  return compute_inside_masks(oriented_mesh, LazyWindingTree(tree), lists, options);
+}
+
+InsideMasksResult compute_inside_masks(const TriangleMesh& oriented_mesh,
+                                       const LazyWindingTree& tree,
                                        const BrickTriangleLists& lists,
                                        const InsideMasksOptions& options) {
   if (lists.offsets.empty() && lists.bricks.empty()) return {};
@@ -160,8 +276,17 @@ InsideMasksResult compute_inside_masks(const TriangleMesh& oriented_mesh,
   InsideMasksResult result;
   const OpenEdgeInfo open = find_open_edges(oriented_mesh, grid_vertices, grid, lists);
   result.open_edges = open.count;
-  const std::vector<bool>& unsafe = open.near_brick;
   const std::size_t nb = lists.bricks.size();
+  // The jumps across brick faces need every triangle crossing such an edge listed in one of
+  // the two bricks: a margin of half a voxel.
+  if (open.count == 0 && options.closed_by_rays && lists.margin >= 0.5 * frame.voxel_size) {
+    if (auto inside = closed_masks(grid, lists, options, result.ray_queries)) {
+      result.inside = std::move(*inside);
+      options.progress.step(1.0, "sign");
+      return result;
+    }
+  }
+  const std::vector<bool>& unsafe = open.near_brick;
   result.inside.resize(nb);
   const BrickWindingContext context{tree, frame, options.beta};
   std::vector<std::uint64_t> queries(nb, 0);

@@ -12,8 +12,14 @@
 //   edges, more near them); open_edges and direct_bricks (bricks near open edges) for reports.
 // Method: per brick, the integer winding-number jumps along grid edges come from watertight
 //   signed crossings of its listed triangles with the grid lines (grid_crossings.hpp).
-//   - Bricks away from open edges (all bricks of a closed mesh, however self-intersecting or
-//     multiply covered): one tree query at a reference voxel (interior, nearest the brick
+//   - Closed meshes (no open edge, however self-intersecting or multiply covered): no tree.
+//     Each brick's winding numbers relative to its base voxel (relative_winding), the exact
+//     changes from its base to its face neighbours' bases (the base's line plus the edge across
+//     the face, edge_jump), and per face-connected group of bricks one exact ray from a base
+//     (ray_winding): exact integers everywhere. Links that disagree (impossible for a closed
+//     mesh) or more than max_ray_work ray tests (many small groups), or lists binned with a margin
+//     below h/2 (lists.margin), fall back to the next way.
+//   - Bricks away from open edges (and the fallback above): one tree query at a reference voxel (interior, nearest the brick
 //     centre, as far as possible from crossed edges), then w = w_ref + the jumps along the path
 //     reference -> x -> y -> z (brick_winding.hpp, inside_from_reference). Exact for closed
 //     meshes: path independent, up to the tree's error in w_ref (~1e-2, far below 1/2).
@@ -51,16 +57,26 @@ namespace levelset {
 struct InsideMasksOptions {
   GridFrame frame;
   double beta = 2.0;  // winding tree accuracy (see winding_number.hpp)
+  // Closed meshes: exact integer winding numbers by rays and jumps instead of the tree, unless
+  // rays x triangles would exceed max_ray_work (many separate groups of bricks).
+  bool closed_by_rays = true;
+  double max_ray_work = 1e8;
   ProgressHook progress;
 };
 
 struct InsideMasksResult {
   std::vector<BrickMask> inside;      // one per lists.bricks[i]
   std::uint64_t winding_queries = 0;  // tree evaluations
+  std::uint64_t ray_queries = 0;      // exact ray winding numbers (closed meshes)
   std::uint64_t open_edges = 0;       // edges where the oriented surface is not closed
   std::uint64_t direct_bricks = 0;    // bricks evaluated voxel by voxel (near open edges)
 };
 
+// The tree is built only where it is needed (open meshes, or the fallback).
+InsideMasksResult compute_inside_masks(const TriangleMesh& oriented_mesh,
+                                       const LazyWindingTree& tree,
+                                       const BrickTriangleLists& lists,
+                                       const InsideMasksOptions& options);
 InsideMasksResult compute_inside_masks(const TriangleMesh& oriented_mesh,
                                        const WindingNumberTree& tree,
                                        const BrickTriangleLists& lists,

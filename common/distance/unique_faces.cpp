@@ -1,26 +1,16 @@
 #include "distance/unique_faces.hpp"
 
 #include <algorithm>
-#include <numeric>
-#include <tuple>
+
+#include <tbb/parallel_sort.h>
+
+#include "distance/open_edges.hpp"
 
 namespace levelset {
 
 UniqueFacesResult unique_faces(const TriangleMesh& mesh) {
-  // Weld: vertices sorted by coordinates; equal runs map to the first of the run.
-  const std::size_t nv = mesh.vertices.size();
-  std::vector<std::uint32_t> order(nv);
-  std::iota(order.begin(), order.end(), 0u);
-  auto coords = [&](std::uint32_t i) {
-    const Vec3d& v = mesh.vertices[i];
-    return std::make_tuple(v.x, v.y, v.z);
-  };
-  std::sort(order.begin(), order.end(), [&](std::uint32_t a, std::uint32_t b) {
-    return coords(a) != coords(b) ? coords(a) < coords(b) : a < b;
-  });
-  std::vector<std::uint32_t> weld(nv);
-  for (std::size_t k = 0; k < nv; ++k)
-    weld[order[k]] = (k > 0 && coords(order[k]) == coords(order[k - 1])) ? weld[order[k - 1]] : order[k];
+  // Weld: equal positions map to the lowest index among them.
+  const std::vector<std::uint32_t> weld = weld_exact(mesh.vertices);
 
   UniqueFacesResult result;
   result.mesh.vertices = mesh.vertices;
@@ -46,7 +36,7 @@ UniqueFacesResult unique_faces(const TriangleMesh& mesh) {
     std::sort(t.begin(), t.end());
     keys.push_back({t, static_cast<std::uint32_t>(f), orientation});
   }
-  std::sort(keys.begin(), keys.end(), [](const Key& a, const Key& b) {
+  tbb::parallel_sort(keys.begin(), keys.end(), [](const Key& a, const Key& b) {
     return a.sorted != b.sorted ? a.sorted < b.sorted : a.face < b.face;
   });
   // Copies of a face: their orientations add up. Opposite copies cancel (a double-sided sheet

@@ -8,7 +8,7 @@
 // (a double-sided sheet encloses nothing). Winding numbers of a soup count every copy of a face,
 // so a duplicated face would otherwise change inside/outside near it; distances do not
 // depend on this (the closest point transform uses the mesh as given).
-// Cost: O(V log V + F log F). Threading: serial sorts. Errors: none beyond bad_alloc.
+// Cost: O(V log V + F log F). Threading: TBB sorts; the result is the same for any thread count. Errors: none beyond bad_alloc.
 #pragma once
 
 #include "io/triangle_mesh.hpp"

@@ -25,6 +25,10 @@
 //   beta = 2: 5e-3 (the default: ~3 us per query near 75k triangles), beta = 3: 8e-4,
 //   beta = 4: 3e-4 (~14 us). Cost O(log F) nodes away from the surface, more near it.
 //   Threading: const, safe to call concurrently. Errors: none.
+// LazyWindingTree
+//   A tree that is built on first use (get(), thread-safe: one build, concurrent callers wait),
+//   or one the caller already has. The sign code needs it only for open meshes and as a
+//   fallback, so closed meshes never pay for the build. The mesh must outlive it.
 // winding_number_exact(mesh, p)
 //   The brute-force sum over all triangles (reference for tests), O(F). Indices must be valid.
 #pragma once
@@ -32,6 +36,8 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <mutex>
+#include <optional>
 #include <vector>
 
 #include "core/vec3.hpp"
@@ -63,6 +69,26 @@ struct WindingNumberTree {
 WindingNumberTree build_winding_tree(const TriangleMesh& mesh);
 
 double winding_number(const WindingNumberTree& tree, const Vec3d& p, double beta = 2.0);
+
+class LazyWindingTree {
+ public:
+  explicit LazyWindingTree(const TriangleMesh& mesh) : mesh_(&mesh) {}
+  explicit LazyWindingTree(const WindingNumberTree& tree) : given_(&tree) {}
+  const WindingNumberTree& get() const {
+    if (given_) return *given_;
+    std::call_once(once_, [this] { owned_.emplace(build_winding_tree(*mesh_)); });
+    return *owned_;
+  }
+  // The tree the caller gave (nullptr when it is built here).
+  const WindingNumberTree* given() const { return given_; }
+  bool built() const { return given_ != nullptr || owned_.has_value(); }
+
+ private:
+  const TriangleMesh* mesh_ = nullptr;
+  const WindingNumberTree* given_ = nullptr;
+  mutable std::once_flag once_;
+  mutable std::optional<WindingNumberTree> owned_;
+};
 
 double winding_number_exact(const TriangleMesh& mesh, const Vec3d& p);
 

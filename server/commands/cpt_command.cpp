@@ -70,6 +70,7 @@ int run_cpt(const CptArgs& args) {
   stats.extra["distance_evaluations"] = cpt.evaluations;
   stats.extra["faces_flipped"] = cpt.faces_flipped;
   stats.extra["winding_queries"] = cpt.winding_queries;
+  stats.extra["ray_queries"] = cpt.ray_queries;
   stats.extra["open_edges"] = cpt.open_edges;
   stats.extra["membrane_voxels"] = cpt.membrane_voxels;
   stats.extra["membrane_bricks_added"] = cpt.membrane_bricks_added;

@@ -55,11 +55,23 @@ Masks compute(const TriangleMesh& oriented, double h, Vec3d origin, double margi
   options.frame = m.frame;
   m.result = compute_inside_masks(oriented, tree, m.lists, options);
   EXPECT_EQ(m.result.inside.size(), m.lists.bricks.size());
-  // One query per brick, 512 (minus voxels on the surface) per brick near open edges.
-  EXPECT_GE(m.result.winding_queries, m.lists.bricks.size());
-  EXPECT_LE(m.result.winding_queries, m.lists.bricks.size() + 511 * m.result.direct_bricks);
   if (m.result.open_edges == 0) {
-    EXPECT_EQ(m.result.direct_bricks, 0u);
+    // Closed: exact rays and jumps, no tree query; the per-brick tree path (one query per
+    // brick) agrees on every voxel.
+    EXPECT_EQ(m.result.winding_queries, 0u);
+    EXPECT_GE(m.result.ray_queries, m.lists.bricks.empty() ? 0u : 1u);
+    InsideMasksOptions by_tree = options;
+    by_tree.closed_by_rays = false;
+    const InsideMasksResult t = compute_inside_masks(oriented, tree, m.lists, by_tree);
+    EXPECT_EQ(t.winding_queries, m.lists.bricks.size());
+    EXPECT_EQ(t.direct_bricks, 0u);
+    std::size_t differ = 0;
+    for (std::size_t i = 0; i < m.lists.bricks.size(); ++i) differ += !(t.inside[i] == m.result.inside[i]);
+    EXPECT_EQ(differ, 0u) << "bricks where rays and tree disagree";
+  } else {
+    // One query per brick, 512 (minus voxels on the surface) per brick near open edges.
+    EXPECT_GE(m.result.winding_queries, m.lists.bricks.size());
+    EXPECT_LE(m.result.winding_queries, m.lists.bricks.size() + 511 * m.result.direct_bricks);
   }
   return m;
 }
@@ -270,6 +282,55 @@ TEST(InsideMasks, OverlappingSpheresSoupIsTheirUnion) {
     twice += in_a && in_b;
   });
   EXPECT_GT(twice, 100u);
+}
+
+// Closed soups whose bricks fall into separate face-connected groups: a hollow ball (outer
+// sphere outward, inner sphere inward: inside only between them), a separate sphere far away,
+// and a sphere overlapping the ball (winding number 2). Each group is anchored by its own exact
+// ray; with no ray budget the tree path takes over and gives the same masks.
+TEST(InsideMasks, ClosedSoupsInSeparateGroupsAndTheRayBudget) {
+  TriangleMesh soup;
+  auto append = [&](TriangleMesh part, bool inward) {
+    const std::uint32_t off = std::uint32_t(soup.vertices.size());
+    soup.vertices.insert(soup.vertices.end(), part.vertices.begin(), part.vertices.end());
+    for (auto f : part.triangles)
+      soup.triangles.push_back(inward ? std::array<std::uint32_t, 3>{f[0] + off, f[2] + off, f[1] + off}
+                                      : std::array<std::uint32_t, 3>{f[0] + off, f[1] + off, f[2] + off});
+  };
+  const Vec3d c{0.013, -0.021, 0.017}, far{5.03, 0.11, -0.07}, over{0.97, 0.05, 0.02};
+  append(test::icosphere(3, 1.0, c), false);
+  append(test::icosphere(3, 0.5, c), true);
+  append(test::icosphere(3, 0.6, far), false);
+  append(test::icosphere(3, 0.4, over), false);
+  const Masks m = compute(soup, 0.05, {0, 0, 0}, 1.0);  // also checks rays == tree path
+  ASSERT_EQ(m.result.open_edges, 0u);
+  EXPECT_GE(m.result.ray_queries, 2u);  // the far sphere's bricks touch no other group
+  std::size_t checked = 0, shell = 0, twice = 0;
+  m.for_each_voxel([&](const Vec3d& p, const Coord&, bool bit) {
+    const double rc = length(p - c), rf = length(p - far), ro = length(p - over);
+    // Away from the faceted surfaces (0.01 covers the icospheres' chord error), the analytic
+    // answer: w = [rc < 1] - [rc < 0.5] + [rf < 0.6] + [ro < 0.4].
+    const double margin = 0.01;
+    if (std::abs(rc - 1.0) < margin || std::abs(rc - 0.5) < margin || std::abs(rf - 0.6) < margin ||
+        std::abs(ro - 0.4) < margin)
+      return;
+    const int w = (rc < 1.0) - (rc < 0.5) + (rf < 0.6) + (ro < 0.4);
+    ASSERT_EQ(bit, w >= 1) << p.x << " " << p.y << " " << p.z;
+    ++checked;
+    shell += rc > 0.5 && rc < 1.0;
+    twice += w == 2;
+  });
+  EXPECT_GT(checked, 10000u);
+  EXPECT_GT(shell, 1000u);
+  EXPECT_GT(twice, 100u);
+
+  InsideMasksOptions options;
+  options.frame = m.frame;
+  options.max_ray_work = 0.0;
+  const InsideMasksResult fallback = compute_inside_masks(soup, build_winding_tree(soup), m.lists, options);
+  EXPECT_EQ(fallback.ray_queries, 0u);
+  EXPECT_EQ(fallback.winding_queries, m.lists.bricks.size());
+  EXPECT_EQ(fallback.inside, m.result.inside);
 }
 
 TEST(InsideMasks, FlippedFacesAfterOrientationGiveIdenticalMasks) {
