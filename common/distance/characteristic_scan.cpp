@@ -127,6 +127,12 @@ class MinField {
   const BrickSet& set() const { return set_; }
   std::size_t size() const { return cells_.size(); }
   std::uint64_t load(std::size_t i) const { return cells_[i].load(std::memory_order_relaxed); }
+  // The best distance offered so far (+inf: none). Another thread may lower it at any time;
+  // a value above it can never win, so callers may skip computing such values.
+  float best(std::size_t cell) const {
+    const std::uint64_t v = cells_[cell].load(std::memory_order_relaxed);
+    return v == kEmpty ? std::numeric_limits<float>::infinity() : std::bit_cast<float>(std::uint32_t(v >> 32));
+  }
   void offer(std::size_t cell, float distance, std::uint32_t tri) {
     const std::uint64_t value = (std::uint64_t(std::bit_cast<std::uint32_t>(distance)) << 32) | tri;
     std::uint64_t old = cells_[cell].load(std::memory_order_relaxed);
@@ -150,8 +156,12 @@ class Scanner {
   }
   std::uint64_t evaluations = 0, polyhedra = 0;
 
-  // Scan-converts p: voxels inside get their distance to triangle tri.
-  void scan(const Polyhedron& p, std::uint32_t tri) {
+  // Scan-converts p: voxels inside get their distance to triangle tri, whose unit normal is n
+  // (zero when degenerate). Voxels whose distance to the triangle's plane, less
+  // plane_margin (TriangleFrame), already exceeds their best distance (overlapping
+  // polyhedra, common where the band is wider than the surface's radius of curvature) are
+  // skipped: that bounds the distance from below, so they could not win.
+  void scan(const Polyhedron& p, std::uint32_t tri, const Vec3d& n, double plane_margin) {
     ++polyhedra;
     int lo[3], hi[3];
     for (int a = 0; a < 3; ++a) {
@@ -166,18 +176,32 @@ class Scanner {
     const int u = (k + 1) % 3, v = (k + 2) % 3;
     const auto& f = mesh_.triangles[tri];
     const Vec3d &ta = mesh_.vertices[f[0]], &tb = mesh_.vertices[f[1]], &tc = mesh_.vertices[f[2]];
+    // Per column (xu, xv), plane i bounds t along k by (c - g_u xu - g_v xv) / g_k: from above
+    // where g_k > 0, from below where g_k < 0; planes parallel to k cut whole columns. Sorted
+    // once per polyhedron into branch-free lists, with the reciprocals.
+    double up_c[24], up_u[24], up_v[24], up_inv[24], dn_c[24], dn_u[24], dn_v[24], dn_inv[24];
+    double par_c[24], par_u[24], par_v[24];
+    int nup = 0, ndn = 0, npar = 0;
+    for (int i = 0; i < p.planes; ++i) {
+      const double s = p.g[i][k];
+      if (s > 1e-300) {
+        up_c[nup] = p.c[i], up_u[nup] = p.g[i][u], up_v[nup] = p.g[i][v], up_inv[nup++] = 1.0 / s;
+      } else if (s < -1e-300) {
+        dn_c[ndn] = p.c[i], dn_u[ndn] = p.g[i][u], dn_v[ndn] = p.g[i][v], dn_inv[ndn++] = 1.0 / s;
+      } else {
+        par_c[npar] = p.c[i], par_u[npar] = p.g[i][u], par_v[npar++] = p.g[i][v];
+      }
+    }
     for (int jv = lo[v]; jv <= hi[v]; ++jv) {
       const double xv = frame_.origin[v] + jv * h_;
       for (int ju = lo[u]; ju <= hi[u]; ++ju) {
         const double xu = frame_.origin[u] + ju * h_;
         double t0 = frame_.origin[k] + lo[k] * h_, t1 = frame_.origin[k] + hi[k] * h_;
-        for (int i = 0; i < p.planes && t0 <= t1; ++i) {
-          const double s = p.g[i][k], rhs = p.c[i] - p.g[i][u] * xu - p.g[i][v] * xv;
-          if (s > 1e-300) t1 = std::min(t1, rhs / s);
-          else if (s < -1e-300) t0 = std::max(t0, rhs / s);
-          else if (rhs < 0) t1 = t0 - 1;  // parallel and outside
-        }
-        if (t0 > t1) continue;
+        bool cut = false;
+        for (int i = 0; i < npar; ++i) cut |= par_c[i] - par_u[i] * xu - par_v[i] * xv < 0;
+        for (int i = 0; i < nup; ++i) t1 = std::min(t1, (up_c[i] - up_u[i] * xu - up_v[i] * xv) * up_inv[i]);
+        for (int i = 0; i < ndn; ++i) t0 = std::max(t0, (dn_c[i] - dn_u[i] * xu - dn_v[i] * xv) * dn_inv[i]);
+        if (cut || t0 > t1) continue;
         const int k0 = std::max(lo[k], int(std::ceil((t0 - frame_.origin[k]) / h_ - 1e-9)));
         const int k1 = std::min(hi[k], int(std::floor((t1 - frame_.origin[k]) / h_ + 1e-9)));
         Coord c;
@@ -189,11 +213,15 @@ class Scanner {
         for (int kk = k0; kk <= k1; ++kk) {
           c[k] = kk;
           x[k] = frame_.origin[k] + kk * h_;
+          const std::size_t cell = cell_of(c);
+          if (cell == kNoCell) continue;
+          // A lower bound, also under the rounding of the distance itself (relative margin).
+          const double plane = std::abs(dot(n, x - ta)) * (1.0 - 1e-6) - plane_margin;
+          if (plane > r_ || plane > double(field_.best(cell))) continue;
           const double d2 = closest_point_on_triangle(x, ta, tb, tc).distance_squared;
           ++evaluations;
           if (!(d2 <= band2_)) continue;
-          const std::size_t cell = cell_of(c);
-          if (cell != kNoCell) field_.offer(cell, static_cast<float>(std::sqrt(d2)), tri);
+          field_.offer(cell, static_cast<float>(std::sqrt(d2)), tri);
         }
       }
     }
@@ -221,6 +249,7 @@ class Scanner {
 
  public:
   double slack() const { return slack_; }
+  double voxel_size() const { return h_; }
   double radius() const { return r_; }
 };
 
@@ -246,9 +275,29 @@ struct TriangleFrame {
   Vec3d m[3];  // edge k = (v_k, v_k+1): outward in-plane unit normal
   bool flat = false;
   double scale = 0;  // longest edge
+  // |n . (x - v0)| - plane_margin bounds the distance from below at every x within the band
+  // of the triangle (+inf: no bound, for slivers whose computed normal is too inaccurate).
+  double plane_margin = std::numeric_limits<double>::infinity();
 };
 
-TriangleFrame triangle_frame(const TriangleMesh& mesh, std::uint32_t t) {
+// The margin covers the rounding of the computed normal (relative error ~ u times the
+// condition scale^2 / area, worse where coordinates are large against the edges) over
+// distances up to r + 2 scale, and of the differences; it is used only where it stays below
+// h / 10, so that skipping still pays.
+double plane_margin(const TriangleFrame& tf, double area2, double r, double h) {
+  constexpr double u = 1.2e-16;
+  double coords = 0, shortest = std::numeric_limits<double>::infinity();
+  for (int k = 0; k < 3; ++k) {
+    coords = std::max({coords, std::abs(tf.v[k].x), std::abs(tf.v[k].y), std::abs(tf.v[k].z)});
+    shortest = std::min(shortest, length(tf.v[(k + 1) % 3] - tf.v[k]));
+  }
+  if (!(shortest > 0)) return std::numeric_limits<double>::infinity();
+  const double normal_error = 8 * u * (tf.scale * tf.scale / area2) * (1 + coords / shortest);
+  const double margin = 1e-3 * h + 10 * (normal_error * (r + 2 * tf.scale) + 2 * u * (coords + r + tf.scale));
+  return margin <= 0.1 * h ? margin : std::numeric_limits<double>::infinity();
+}
+
+TriangleFrame triangle_frame(const TriangleMesh& mesh, std::uint32_t t, double r, double h) {
   const auto& f = mesh.triangles[t];
   TriangleFrame tf;
   for (int k = 0; k < 3; ++k) tf.v[k] = mesh.vertices[f[k]];
@@ -258,20 +307,29 @@ TriangleFrame triangle_frame(const TriangleMesh& mesh, std::uint32_t t) {
   tf.flat = area2 > 1e-12 * tf.scale * tf.scale;
   tf.n = tf.flat ? big / area2 : Vec3d{0, 0, 0};
   for (int k = 0; k < 3; ++k) tf.m[k] = tf.flat ? unit(cross(tf.v[(k + 1) % 3] - tf.v[k], tf.n)) : Vec3d{0, 0, 0};
+  if (tf.flat) tf.plane_margin = plane_margin(tf, area2, r, h);
   return tf;
 }
 
-// The face's prism: the points that project into it, within W h of its plane.
-void scan_prism(const TriangleFrame& tf, std::uint32_t t, Scanner& scanner) {
+// The face's prism: the points that project into it, within W h of its plane; with `cover` > 0
+// its edge planes move out by that much (scan_triangle_features: it then also holds thin
+// wedges of its edges).
+void scan_prism(const TriangleFrame& tf, std::uint32_t t, double cover, Scanner& scanner) {
   const double r = scanner.radius(), eps = scanner.slack();
   Polyhedron p;
-  for (int k = 0; k < 3; ++k) p.add_through(tf.m[k], tf.v[k], eps);
+  for (int k = 0; k < 3; ++k) p.add_through(tf.m[k], tf.v[k], eps + cover);
   p.add_through(tf.n, tf.v[0], r + eps);
   p.add_through(tf.n * -1.0, tf.v[0], r + eps);
+  // Corner k of the offset triangle: w . m_(k-1) = w . m_k = the offset.
+  Vec3d corner[3];
+  for (int k = 0; k < 3; ++k) {
+    const Vec3d& before = tf.m[(k + 2) % 3];
+    corner[k] = cover > 0 ? tf.v[k] + (before + tf.m[k]) * ((eps + cover) / (1.0 + dot(before, tf.m[k]))) : tf.v[k];
+  }
   const Vec3d off = tf.n * (r + eps);
-  const Vec3d pts[6] = {tf.v[0] + off, tf.v[1] + off, tf.v[2] + off, tf.v[0] - off, tf.v[1] - off, tf.v[2] - off};
+  const Vec3d pts[6] = {corner[0] + off, corner[1] + off, corner[2] + off, corner[0] - off, corner[1] - off, corner[2] - off};
   p.box_of(pts, 6);
-  scanner.scan(p, t);
+  scanner.scan(p, t, tf.n, tf.plane_margin);
 }
 
 // The outward in-plane normal of `other` at the edge (p0, axis), or nothing when `other` is
@@ -291,43 +349,79 @@ bool other_face_normal(const TriangleMesh& mesh, const Adjacency& adj, std::uint
   return true;
 }
 
+// Edge k of a face: its direction and, where the edge is manifold, the in-plane outward normal
+// of the face across it.
+struct EdgeWedge {
+  bool point = false;  // zero length: the vertices' cones cover it
+  bool bounded = false;  // the face across gives the wedge's second side (m2)
+  Vec3d axis, m2;
+};
+
+EdgeWedge edge_wedge(const TriangleMesh& mesh, const Adjacency& adj, const TriangleFrame& tf, std::uint32_t t, int k) {
+  EdgeWedge w;
+  const Vec3d &p0 = tf.v[k], &p1 = tf.v[(k + 1) % 3];
+  if (length(p1 - p0) == 0.0) {
+    w.point = true;
+    return w;
+  }
+  w.axis = unit(p1 - p0);
+  if (!tf.flat) return w;
+  const auto& f = mesh.triangles[t];
+  const std::uint32_t other = adj.across[3 * std::size_t(t) + std::size_t(k)];
+  w.bounded = other != kNoTriangle &&
+              other_face_normal(mesh, adj, other, p0, w.axis, adj.welded[f[k]], adj.welded[f[(k + 1) % 3]], tf.scale, w.m2);
+  return w;
+}
+
+// The wedge's two sides in cross-section: directions perpendicular to the edge with u.m >= 0
+// and u.m2 >= 0, bounded by d1 (perpendicular to m) and d2 (perpendicular to m2).
+void wedge_sides(const Vec3d& axis, const Vec3d& m, const Vec3d& m2, Vec3d& d1, Vec3d& d2) {
+  d1 = unit(cross(axis, m));
+  d2 = unit(cross(axis, m2));
+  if (dot(d1, m2) < 0) d1 = d1 * -1.0;
+  if (dot(d2, m) < 0) d2 = d2 * -1.0;
+}
+
+// How far beyond the face's edge plane (along m_k) the wedge of edge k reaches within r of the
+// edge. In cross-section the wedge {u . m >= 0, u . m2 >= 0} opens by psi = pi - angle(m, m2)
+// (0 for coplanar faces, pi for a face folded back onto its neighbour); for psi < 60 degrees
+// its farthest point from the plane u . m = 0 is on the side u . m2 = 0 at distance r, so the
+// reach is r sin(psi). +inf for unbounded edges and wider wedges; 0 for a zero-length edge.
+double wedge_reach(const TriangleFrame& tf, int k, const EdgeWedge& w, double r) {
+  constexpr double kInf = std::numeric_limits<double>::infinity();
+  if (w.point) return 0.0;
+  if (!w.bounded) return kInf;
+  const double c = dot(tf.m[k], w.m2);  // cos(pi - psi)
+  if (!(c < -0.5)) return kInf;
+  return r * std::sqrt(std::max(0.0, 1.0 - c * c));
+}
+
 // Edge k's wedge: beyond the edge as seen from this face (and from the face across it, when the
 // edge is manifold), between the planes through its ends.
-void scan_wedge(const TriangleMesh& mesh, const Adjacency& adj, const TriangleFrame& tf, std::uint32_t t, int k,
-                Scanner& scanner) {
+void scan_wedge(const TriangleFrame& tf, std::uint32_t t, int k, const EdgeWedge& w, Scanner& scanner) {
   const double r = scanner.radius(), eps = scanner.slack();
   const Vec3d &p0 = tf.v[k], &p1 = tf.v[(k + 1) % 3];
-  if (length(p1 - p0) == 0.0) return;  // a point: its vertices' cones cover it
-  const Vec3d axis = unit(p1 - p0);
+  if (w.point) return;  // a point: its vertices' cones cover it
   Polyhedron p;
-  p.add_through(axis * -1.0, p0, eps);
-  p.add_through(axis, p1, eps);
+  p.add_through(w.axis * -1.0, p0, eps);
+  p.add_through(w.axis, p1, eps);
   const Vec3d e{r + eps, r + eps, r + eps};
   p.lo = min(p0, p1) - e;  // the cylinder's box unless the wedge is narrower
   p.hi = max(p0, p1) + e;
   if (tf.flat) {
     p.add_through(tf.m[k] * -1.0, p0, eps);
-    const auto& f = mesh.triangles[t];
-    const std::uint32_t other = adj.across[3 * std::size_t(t) + std::size_t(k)];
-    Vec3d m2;
-    if (other != kNoTriangle &&
-        other_face_normal(mesh, adj, other, p0, axis, adj.welded[f[k]], adj.welded[f[(k + 1) % 3]], tf.scale, m2)) {
-      p.add_through(m2 * -1.0, p0, eps);
-      // The cross-section: directions u perpendicular to the edge with u.m >= 0 and u.m2 >= 0;
-      // its sides are perpendicular to m and to m2.
-      Vec3d d1 = unit(cross(axis, tf.m[k])), d2 = unit(cross(axis, m2));
-      if (dot(d1, m2) < 0) d1 = d1 * -1.0;
-      if (dot(d2, tf.m[k]) < 0) d2 = d2 * -1.0;
-      const Vec3d sum = tf.m[k] + m2;
+    if (w.bounded) {
+      p.add_through(w.m2 * -1.0, p0, eps);
+      Vec3d d1, d2;
+      wedge_sides(w.axis, tf.m[k], w.m2, d1, d2);
+      const Vec3d sum = tf.m[k] + w.m2;
       // Coplanar faces: the wedge is the plane through the edge along n, whose points project
       // onto the edge, on both prisms' boundaries (within their slack): nothing to add.
       if (length(sum) < 1e-9) return;
-      {
-        wedge_box(p, p0, p1, d1, d2, unit(sum), std::clamp(dot(d1, d2), -1.0, 1.0), r + eps);
-      }
+      wedge_box(p, p0, p1, d1, d2, unit(sum), std::clamp(dot(d1, d2), -1.0, 1.0), r + eps);
     }
   }
-  scanner.scan(p, t);
+  scanner.scan(p, t, tf.n, tf.plane_margin);
 }
 
 // All rays on one line (the cone of a flat vertex is the normal line, +-n).
@@ -409,13 +503,37 @@ void scan_cone(const TriangleMesh& mesh, const Adjacency& adj, const TriangleFra
     p.lo = max(box.lo, p.lo);
     p.hi = min(box.hi, p.hi);
   }
-  scanner.scan(p, t);
+  scanner.scan(p, t, tf.n, tf.plane_margin);
 }
 
+// Thin wedges (nearly coplanar neighbours: smooth, densely triangulated surfaces) are scanned as
+// part of the face's prism, its edge planes moved out by the wedges' reach: a wedge's point x =
+// p + a m_k + b n (p on edge k, 0 <= a <= reach) has (x - v_j) . m_j <= a |m_k . m_j| <= reach
+// for every edge j, and |b| <= r. A wedge polyhedron's box mostly misses it (slanted slivers),
+// so its columns cost far more than the prism's extra rim. Not for faces with an angle under
+// ~18 degrees, whose offset corners would move far.
+constexpr double kMaxWedgeCover = 0.25;  // voxels (measured: 1 and a tenth of the shortest edge gain no more)
+
 void scan_triangle_features(const TriangleMesh& mesh, const Adjacency& adj, std::uint32_t t, Scanner& scanner) {
-  const TriangleFrame tf = triangle_frame(mesh, t);
-  if (tf.flat) scan_prism(tf, t, scanner);
-  for (int k = 0; k < 3; ++k) scan_wedge(mesh, adj, tf, t, k, scanner);
+  const TriangleFrame tf = triangle_frame(mesh, t, scanner.radius(), scanner.voxel_size());
+  EdgeWedge wedges[3];
+  for (int k = 0; k < 3; ++k) wedges[k] = edge_wedge(mesh, adj, tf, t, k);
+  bool covered[3] = {false, false, false};
+  double cover = 0.0;
+  if (tf.flat) {
+    bool sharp = false;
+    for (int k = 0; k < 3; ++k) sharp |= 1.0 + dot(tf.m[(k + 2) % 3], tf.m[k]) < 0.05;
+    const double r = scanner.radius() + scanner.slack();
+    for (int k = 0; k < 3 && !sharp; ++k) {
+      const double reach = wedge_reach(tf, k, wedges[k], r);
+      if (reach > kMaxWedgeCover * scanner.voxel_size()) continue;
+      covered[k] = true;
+      cover = std::max(cover, reach + 2 * scanner.slack());
+    }
+    scan_prism(tf, t, cover, scanner);
+  }
+  for (int k = 0; k < 3; ++k)
+    if (!covered[k]) scan_wedge(tf, t, k, wedges[k], scanner);
   for (int k = 0; k < 3; ++k) scan_cone(mesh, adj, tf, t, k, scanner);
 }
 

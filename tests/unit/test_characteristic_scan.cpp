@@ -20,6 +20,7 @@
 #include "grid/build_from_sdf.hpp"
 #include "io/mesh_reader.hpp"
 #include "mesh_subdivide.hpp"
+#include "surface/marching_cubes.hpp"
 
 namespace levelset {
 namespace {
@@ -117,6 +118,18 @@ TEST(CharacteristicScan, EqualsTheSlabScanOnDenseMeshes) {
   }
   const TriangleMesh sphere = test::icosphere(6, 1.0, {0.1, -0.2, 0.3});  // 81920 faces
   expect_same("icosphere 6 W=6", compare_methods(sphere, frame_for_resolution(sphere.bounds(), 128, 6.0)));
+  // A mesh extracted by marching cubes, transformed again on its own grid: every vertex on a
+  // grid line, voxel centres exactly on the surface, slivers (bench_cpt's headline row).
+  const BBox box{{-1, -1, -1}, {1, 1, 1}};
+  SdfBuildOptions build;
+  build.frame = frame_for_resolution(box, 96, 3.0);
+  const TriangleMesh extracted =
+      marching_cubes(build_from_sdf([](const Vec3d& p) { return length(p) - 0.8; }, box, build).band).mesh;
+  for (const double w : {3.0, 6.0}) {
+    GridFrame same_grid = build.frame;
+    same_grid.half_width = w;
+    expect_same("marching cubes sphere W=" + std::to_string(int(w)), compare_methods(extracted, same_grid));
+  }
 }
 
 // A sphere inside a box, a thin slab, a torus: polyhedra of separate sheets overlap in the band.
