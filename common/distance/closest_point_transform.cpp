@@ -210,16 +210,18 @@ std::vector<MembraneBrick> pack_bricks(const TriangleMesh& mesh, const ClosestTr
 
 // The method when the caller leaves it to us. The slab scan's work grows with W^3 per triangle,
 // the characteristic scan's with the band's voxels (one to two evaluations each) plus a fixed
-// cost per polyhedron; the slab scan is cheaper only for narrow bands around coarse meshes
-// (measured at R = 256, W = 3, 2 threads: knot.off, 4k triangles, 0.23 s against 0.30 s;
-// bunny00.off, 75k triangles, 0.96 s against 0.69 s).
+// cost per polyhedron; the slab scan is cheaper only for narrow bands around very coarse
+// meshes. Measured at W = 3, 2 threads (slab / characteristic, triangles per surface voxel):
+// knot.off R = 512 0.33 / 0.38 s (0.008), eight.off R = 512 0.14 / 0.16 s (0.002), elephant.off
+// R = 512 0.22 / 0.22 s (0.018), knot.off R = 256 0.15 / 0.11 s (0.033), fandisk.off R = 512
+// 0.35 / 0.30 s (0.023), bunny00.off R = 512 0.82 / 0.59 s (0.12).
 CptMethod choose_method(const TriangleMesh& mesh, const GridFrame& frame) {
   if (frame.half_width > 3.0) return CptMethod::characteristic;
   double area = 0;
   for (const auto& f : mesh.triangles)
     area += 0.5 * length(cross(mesh.vertices[f[1]] - mesh.vertices[f[0]], mesh.vertices[f[2]] - mesh.vertices[f[0]]));
   const double surface_voxels = area / (frame.voxel_size * frame.voxel_size);
-  return double(mesh.triangles.size()) < 0.25 * surface_voxels ? CptMethod::slab_scan : CptMethod::characteristic;
+  return double(mesh.triangles.size()) < 0.015 * surface_voxels ? CptMethod::slab_scan : CptMethod::characteristic;
 }
 
 }  // namespace

@@ -168,7 +168,10 @@ TEST(CharacteristicScan, IdenticalForOneAndTwoThreads) {
 // characteristic scan for wide bands and dense meshes.
 TEST(CharacteristicScan, AutomaticChoice) {
   const TriangleMesh knot = test::load_cgal_mesh("knot.off");
-  EXPECT_EQ(run(knot, frame_for_resolution(knot.bounds(), 128, 3.0), CptMethod::automatic).method, CptMethod::slab_scan);
+  // Very coarse against the grid (4k triangles, ~500k surface voxels): the slab scan.
+  EXPECT_EQ(run(knot, frame_for_resolution(knot.bounds(), 512, 3.0), CptMethod::automatic).method, CptMethod::slab_scan);
+  EXPECT_EQ(run(knot, frame_for_resolution(knot.bounds(), 128, 3.0), CptMethod::automatic).method,
+            CptMethod::characteristic);
   EXPECT_EQ(run(knot, frame_for_resolution(knot.bounds(), 128, 6.0), CptMethod::automatic).method,
             CptMethod::characteristic);
   const TriangleMesh dense = test::densify(knot, frame_for_resolution(knot.bounds(), 128, 3.0).voxel_size);
