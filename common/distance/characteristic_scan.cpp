@@ -464,6 +464,14 @@ void scan_cone(const TriangleMesh& mesh, const Adjacency& adj, const TriangleFra
     p.add_through(d, v, eps);
   }
   const bool capped = adj.ring_offsets[w + 1] - adj.ring_offsets[w] > 24 || nd < 3;
+  // A vertex whose ring lies in face t's plane (to rounding; flat regions of CAD meshes,
+  // subdivided facets): the ray search below would find exactly +-n, so decide the flat case
+  // (nothing to scan when its edges surround it) without that O(nd^3) search.
+  if (!capped && tf.flat) {
+    bool in_plane = true;
+    for (int i = 0; i < nd && in_plane; ++i) in_plane = std::abs(dot(dirs[i], tf.n)) <= 1e-12;
+    if (in_plane && surrounds(dirs, nd, tf.n)) return;
+  }
   // Extreme rays of {x : x . d_i <= 0}: cross products of pairs that satisfy every constraint
   // (deduplicated); the box of v + R' rays (R' covers the cap between them), else the ball's.
   Vec3d rays[64];
