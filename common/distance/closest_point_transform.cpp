@@ -241,7 +241,9 @@ CptResult closest_point_transform(const TriangleMesh& mesh, const CptOptions& op
   tbb::task_group orienting;
   orienting.run([&] {
     const auto t0 = Clock::now();
-    oriented = orient_faces(unique_faces(mesh).mesh, OrientOptions{});
+    OrientOptions orient;
+    orient.welded = true;  // unique_faces welds
+    oriented = orient_faces(unique_faces(mesh).mesh, orient);
     result.seconds.orient = since(t0);
   });
   // Joins the orientation task on every exit; after an error or a cancel in the scan, the

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <array>
+#include <numeric>
 #include <string>
 #include <utility>
 #include <vector>
@@ -49,7 +50,13 @@ OrientResult orient_faces(const TriangleMesh& mesh, const OrientOptions& options
   OrientResult result;
   result.mesh = mesh;
   // Edges join faces through vertices at exactly equal positions (split seam vertices too).
-  const std::vector<std::uint32_t> id = weld_exact(mesh.vertices);
+  std::vector<std::uint32_t> id;
+  if (options.welded) {
+    id.resize(mesh.vertices.size());
+    std::iota(id.begin(), id.end(), 0u);
+  } else {
+    id = weld_exact(mesh.vertices);
+  }
 
   // Edge uses of non-degenerate faces, grouped by undirected edge.
   std::vector<bool> is_degenerate(nf);

@@ -34,6 +34,9 @@ namespace levelset {
 
 struct OrientOptions {
   ProgressHook progress;
+  // The caller guarantees that vertices at equal positions already share one index (e.g.
+  // unique_faces' output): the exact weld is skipped.
+  bool welded = false;
 };
 
 struct OrientResult {

@@ -8,6 +8,7 @@
 
 #include "core/error.hpp"
 #include "distance/orient_faces.hpp"
+#include "distance/unique_faces.hpp"
 #include "distance_test_meshes.hpp"
 
 namespace levelset {
@@ -188,6 +189,31 @@ TEST(OrientFaces, DeterministicAcrossThreadCountsAndRejectsBadIndices) {
     FAIL() << "expected an error";
   } catch (const Error& e) {
     EXPECT_EQ(e.code(), ErrorCode::InvalidArgument);
+  }
+}
+
+}  // namespace
+}  // namespace levelset
+
+namespace levelset {
+namespace {
+
+// unique_faces' output shares one index per position: orienting it with the weld skipped gives
+// exactly what the full weld gives (the closest point transform relies on this).
+TEST(OrientFaces, WeldedInputSkipsTheWeldWithTheSameResult) {
+  for (const char* name : {"cube-shuffled.off", "knot.off", "elephant-with-holes.off"}) {
+    TriangleMesh m = test::load_cgal_mesh(name);
+    test::flip_random_half(m, 9);
+    const TriangleMesh unique = unique_faces(m).mesh;
+    OrientOptions welded;
+    welded.welded = true;
+    const OrientResult a = orient_faces(unique, OrientOptions{});
+    const OrientResult b = orient_faces(unique, welded);
+    EXPECT_GT(a.faces_flipped, 0u) << name;
+    EXPECT_EQ(a.mesh.triangles, b.mesh.triangles) << name;
+    EXPECT_EQ(a.faces_flipped, b.faces_flipped) << name;
+    EXPECT_EQ(a.components, b.components) << name;
+    EXPECT_EQ(a.inconsistent_edges, b.inconsistent_edges) << name;
   }
 }
 
