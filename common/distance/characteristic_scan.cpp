@@ -498,6 +498,12 @@ void scan_cone(const TriangleMesh& mesh, const Adjacency& adj, const TriangleFra
   // A flat vertex surrounded by its edges: its cone is the normal line, whose points project
   // onto the vertex, on every adjacent prism's boundary (within their slack): nothing to add.
   if (!capped && !overflow && nr >= 1 && is_line(rays, nr) && surrounds(dirs, nd, rays[0])) return;
+  // No extreme ray: the edges positively span space, so the cone is the vertex alone (a saddle
+  // vertex: every point near it is closer to one of its faces or edges, whose polyhedra hold
+  // it). Nothing to scan; its box would otherwise be the whole ball of radius W h. (Every
+  // extreme ray of a cone with more than the apex lies on two constraint planes, so the pair
+  // search above finds it, its tolerance being lenient.)
+  if (!capped && !overflow && nr == 0) return;
   const Vec3d e{r + eps, r + eps, r + eps};
   p.lo = v - e;
   p.hi = v + e;
