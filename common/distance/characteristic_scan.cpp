@@ -418,7 +418,10 @@ void scan_wedge(const TriangleFrame& tf, std::uint32_t t, int k, const EdgeWedge
       // Coplanar faces: the wedge is the plane through the edge along n, whose points project
       // onto the edge, on both prisms' boundaries (within their slack): nothing to add.
       if (length(sum) < 1e-9) return;
-      wedge_box(p, p0, p1, d1, d2, unit(sum), std::clamp(dot(d1, d2), -1.0, 1.0), r + eps);
+      // The opening's cosine from the in-plane normals (pi - angle(m, m2)), not from d1 . d2:
+      // for a face folded back onto its neighbour (m2 ~ m) the sides' flips above are
+      // ambiguous, and d1 . d2 could read a half-space as a thin wedge.
+      wedge_box(p, p0, p1, d1, d2, unit(sum), std::clamp(-dot(tf.m[k], w.m2), -1.0, 1.0), r + eps);
     }
   }
   scanner.scan(p, t, tf.n, tf.plane_margin);

@@ -146,6 +146,15 @@ TEST(CharacteristicScan, SeparateSheetsAndThinParts) {
   expect_same("thin slab W=6", compare_methods(slab, frame_for_resolution(slab.bounds(), 100, 6.0)));
   const TriangleMesh torus = test::torus(1.0, 0.35, 96, 48);
   expect_same("torus W=12", compare_methods(torus, frame_for_resolution(torus.bounds(), 96, 12.0)));
+  // Two faces back to back (a double-sided sheet): at each edge the face across is folded
+  // onto this one, and the edge's wedge is the half-space beyond it (its box once came out
+  // thin there, and voxels beyond the edges were missing).
+  TriangleMesh sheet;
+  sheet.vertices = {{0, 0, 0}, {1, 0.1, 0.05}, {0.3, 0.9, 0.1}};
+  sheet.triangles = {{0, 1, 2}, {0, 2, 1}};
+  for (const double w : {2.0, 4.0})
+    expect_same("double-sided sheet W=" + std::to_string(int(w)),
+                compare_methods(sheet, frame_for_resolution(sheet.bounds(), 64, w)));
 }
 
 TEST(CharacteristicScan, IdenticalForOneAndTwoThreads) {
