@@ -18,7 +18,12 @@
 //   triangle the feature belongs to, keeping the minimum (ties: lowest triangle index). Faces
 //   and edges of every triangle, vertices once (by their lowest-index triangle); vertices are
 //   welded by exact position. So every voxel is evaluated against its true closest triangle:
-//   exact, with about one to two evaluations per band voxel on smooth meshes.
+//   exact, with about one to two evaluations per band voxel on smooth meshes. Shortcuts that
+//   keep this: an edge's wedge thinner than 1/4 voxel at the band's edge (nearly coplanar
+//   faces) is covered by the face's prism with its edge planes moved out by that much; a
+//   vertex whose ring lies in its face's plane, or whose cone is the vertex alone (a saddle),
+//   scans nothing; a voxel whose distance to a triangle's plane (less a rounding margin)
+//   exceeds its best distance so far is not evaluated against that triangle.
 // Cost: O(triangles * columns per polyhedron + band voxels * polyhedra per voxel); memory 8
 //   bytes per voxel of the dilated bricks. Threading: TBB over triangles (atomic minimum per
 //   voxel, order independent): identical results for any thread count.
