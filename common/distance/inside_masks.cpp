@@ -286,6 +286,7 @@ InsideMasksResult compute_inside_masks(const TriangleMesh& oriented_mesh,
       return result;
     }
   }
+  (void)tree.get();  // built here, before the parallel loop (see LazyWindingTree)
   const std::vector<bool>& unsafe = open.near_brick;
   result.inside.resize(nb);
   const BrickWindingContext context{tree, frame, options.beta};

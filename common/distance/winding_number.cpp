@@ -6,6 +6,7 @@
 #include <string>
 
 #include <tbb/parallel_invoke.h>
+#include <tbb/task_arena.h>
 
 #include "core/error.hpp"
 #include "distance/solid_angle.hpp"
@@ -220,6 +221,14 @@ WindingNumberTree build_winding_tree(const TriangleMesh& mesh) {
   tree.order.resize(nt);
   b.build(0, 0, nt);
   return tree;
+}
+
+const WindingNumberTree& LazyWindingTree::get() const {
+  if (given_) return *given_;
+  std::call_once(once_, [this] {
+    tbb::this_task_arena::isolate([this] { owned_.emplace(build_winding_tree(*mesh_)); });
+  });
+  return *owned_;
 }
 
 double winding_number(const WindingNumberTree& tree, const Vec3d& p, double beta) {

@@ -28,7 +28,10 @@
 // LazyWindingTree
 //   A tree that is built on first use (get(), thread-safe: one build, concurrent callers wait),
 //   or one the caller already has. The sign code needs it only for open meshes and as a
-//   fallback, so closed meshes never pay for the build. The mesh must outlive it.
+//   fallback, so closed meshes never pay for the build. The mesh must outlive it. The build
+//   runs in an isolated TBB region: while it waits for its own parallel parts, the building
+//   thread does not pick up outer tasks that could call get() again (a recursive call_once).
+//   Callers that know they need the tree call get() before their parallel loops.
 // winding_number_exact(mesh, p)
 //   The brute-force sum over all triangles (reference for tests), O(F). Indices must be valid.
 #pragma once
@@ -74,11 +77,7 @@ class LazyWindingTree {
  public:
   explicit LazyWindingTree(const TriangleMesh& mesh) : mesh_(&mesh) {}
   explicit LazyWindingTree(const WindingNumberTree& tree) : given_(&tree) {}
-  const WindingNumberTree& get() const {
-    if (given_) return *given_;
-    std::call_once(once_, [this] { owned_.emplace(build_winding_tree(*mesh_)); });
-    return *owned_;
-  }
+  const WindingNumberTree& get() const;
   // The tree the caller gave (nullptr when it is built here).
   const WindingNumberTree* given() const { return given_; }
   bool built() const { return given_ != nullptr || owned_.has_value(); }

@@ -3,7 +3,9 @@
 #include <algorithm>
 #include <cmath>
 #include <random>
+#include <vector>
 
+#include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
 
 #include "core/error.hpp"
@@ -128,6 +130,25 @@ TEST(WindingNumber, SoupsFlippedFacesAndEmptyMesh) {
     EXPECT_EQ(one.nodes[i].center, two.nodes[i].center);
     EXPECT_EQ(one.expansions[i].second, two.expansions[i].second);
   }
+}
+
+// The lazily built tree: one build, the same tree for every caller, also when it is first
+// asked for from inside parallel tasks (the build's own parallel parts must not pick up those
+// outer tasks and call get() again on the same thread).
+TEST(WindingNumber, LazyTreeIsBuiltOnceAlsoFromInsideParallelTasks) {
+  const TriangleMesh m = test::load_cgal_mesh("bunny00.off");
+  const LazyWindingTree lazy(m);
+  EXPECT_FALSE(lazy.built());
+  std::vector<const WindingNumberTree*> seen(512, nullptr);
+  tbb::parallel_for(std::size_t(0), seen.size(), [&](std::size_t i) { seen[i] = &lazy.get(); });
+  EXPECT_TRUE(lazy.built());
+  for (const WindingNumberTree* t : seen) ASSERT_EQ(t, seen[0]);
+  const WindingNumberTree direct = build_winding_tree(m);
+  const Vec3d c = (m.bounds().min + m.bounds().max) * 0.5;
+  EXPECT_EQ(winding_number(*seen[0], c), winding_number(direct, c));
+  EXPECT_EQ(seen[0]->order, direct.order);
+  const LazyWindingTree given(direct);
+  EXPECT_EQ(&given.get(), &direct);
 }
 
 TEST(WindingNumber, BuildRejectsBadInput) {
