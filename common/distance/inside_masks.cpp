@@ -151,7 +151,12 @@ void validate(const TriangleMesh& mesh, const LazyWindingTree& tree,
 // winding numbers relative to its base voxel (relative_winding) and the changes from its base
 // to the bases of its +x, +y, +z neighbours (the base's line plus the edge across the face);
 // then, per face-connected group of bricks, one ray from a base anchors them all.
+// A brick whose relative winding numbers span more levels than this (many nested or stacked
+// shells) keeps its 512 numbers instead of a mask per level: memory stays bounded per brick.
+constexpr int kMaxLevels = 16;
+
 struct RelativeBrick {
+  std::vector<int> rel;                   // deep bricks only (more than kMaxLevels levels)
   int lo = 0;                             // lowest relative winding number in the brick
   std::vector<BrickMask> levels;          // levels[k]: voxels with relative w >= lo + 1 + k
   std::array<std::size_t, 3> next{};      // index of the +axis neighbour (nb: none)
@@ -170,9 +175,13 @@ RelativeBrick relative_brick(std::span<const GridTriangle> grid, const BrickTria
   RelativeBrick out;
   const auto [lo, hi] = std::minmax_element(rel.begin(), rel.end());
   out.lo = *lo;
-  out.levels.resize(std::size_t(*hi - *lo));
-  for (int n = 0; n < kBrickVoxels; ++n)
-    for (int k = 0; k < rel[n] - out.lo; ++k) out.levels[std::size_t(k)].set(n);
+  if (*hi - *lo > kMaxLevels) {
+    out.rel.assign(rel.begin(), rel.end());
+  } else {
+    out.levels.resize(std::size_t(*hi - *lo));
+    for (int n = 0; n < kBrickVoxels; ++n)
+      for (int k = 0; k < rel[n] - out.lo; ++k) out.levels[std::size_t(k)].set(n);
+  }
   for (int a = 0; a < 3; ++a) {
     Coord step{0, 0, 0};
     step[a] = 1;
@@ -247,7 +256,10 @@ std::optional<std::vector<BrickMask>> closed_masks(std::span<const GridTriangle>
     // Inside: w = w(base) + rel >= 1, i.e. rel >= 1 - w(base).
     const int need = 1 - (anchor[group[i]] + base[i]);
     const RelativeBrick& b = bricks[i];
-    if (need <= b.lo)
+    if (!b.rel.empty()) {
+      for (int n = 0; n < kBrickVoxels; ++n)
+        if (b.rel[std::size_t(n)] >= need) inside[i].set(n);
+    } else if (need <= b.lo)
       inside[i].words.fill(~std::uint64_t{0});
     else if (need - b.lo <= int(b.levels.size()))
       inside[i] = b.levels[std::size_t(need - b.lo - 1)];

@@ -18,7 +18,8 @@
 //     the face, edge_jump), and per face-connected group of bricks one exact ray from a base
 //     (ray_winding): exact integers everywhere. Links that disagree (impossible for a closed
 //     mesh) or more than max_ray_work ray tests (many small groups), or lists binned with a margin
-//     below h/2 (lists.margin), fall back to the next way.
+//     below h/2 (lists.margin), fall back to the next way. Exact also for many nested or
+//     stacked shells, where the tree's error grows with their number.
 //   - Bricks away from open edges (and the fallback above): one tree query at a reference voxel (interior, nearest the brick
 //     centre, as far as possible from crossed edges), then w = w_ref + the jumps along the path
 //     reference -> x -> y -> z (brick_winding.hpp, inside_from_reference). Exact for closed

@@ -333,6 +333,44 @@ TEST(InsideMasks, ClosedSoupsInSeparateGroupsAndTheRayBudget) {
   EXPECT_EQ(fallback.inside, m.result.inside);
 }
 
+// 70 nested cubes, all outward, inside one brick: winding numbers up to 70 there. Exact by the
+// ray path (its bricks keep their winding numbers rather than 70 masks); the tree path's error
+// grows with the number of shells, and next to the outermost cube it reads w > 1/2 outside.
+TEST(InsideMasks, DeeplyNestedShellsAreExact) {
+  TriangleMesh soup;
+  for (int k = 0; k < 70; ++k) {
+    const double r = 0.3 + 0.04 * k;
+    const TriangleMesh cube = test::box_mesh({3.5 - r, 3.52 - r, 3.54 - r}, {3.5 + r, 3.52 + r, 3.54 + r});
+    const auto base = std::uint32_t(soup.vertices.size());
+    soup.vertices.insert(soup.vertices.end(), cube.vertices.begin(), cube.vertices.end());
+    for (const auto& f : cube.triangles) soup.triangles.push_back({f[0] + base, f[1] + base, f[2] + base});
+  }
+  GridFrame frame;
+  frame.voxel_size = 1.0;
+  BinTrianglesOptions bin;
+  bin.frame = frame;
+  bin.margin = 1.0;
+  const BrickTriangleLists lists = bin_triangles_to_bricks(soup, bin);
+  InsideMasksOptions options;
+  options.frame = frame;
+  const InsideMasksResult r = compute_inside_masks(soup, build_winding_tree(soup), lists, options);
+  EXPECT_EQ(r.open_edges, 0u);
+  EXPECT_GE(r.ray_queries, 1u);
+  EXPECT_EQ(r.winding_queries, 0u);
+  const double outer = 0.3 + 0.04 * 69;
+  int inside = 0;
+  for (std::size_t i = 0; i < lists.bricks.size(); ++i) {
+    const Coord o = brick_origin(lists.bricks[i]);
+    for (int n = 0; n < kBrickVoxels; ++n) {
+      const Coord g = o + local_coord(n);
+      const bool in = std::abs(g.x - 3.5) < outer && std::abs(g.y - 3.52) < outer && std::abs(g.z - 3.54) < outer;
+      ASSERT_EQ(r.inside[i].test(n), in) << g.x << " " << g.y << " " << g.z;
+      inside += in;
+    }
+  }
+  EXPECT_GT(inside, 100);
+}
+
 TEST(InsideMasks, FlippedFacesAfterOrientationGiveIdenticalMasks) {
   for (const char* name : {"knot.off", "blobby.off"}) {
     const TriangleMesh original = test::load_cgal_mesh(name);
