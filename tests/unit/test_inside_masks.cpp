@@ -1,5 +1,6 @@
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
 #include <cstdlib>
 #include <fstream>
@@ -13,6 +14,7 @@
 
 #include "core/error.hpp"
 #include "distance/brick_triangle_lists.hpp"
+#include "distance/exact_predicates.hpp"
 #include "distance/inside_masks.hpp"
 #include "distance/orient_faces.hpp"
 #include "distance/winding_number.hpp"
@@ -369,6 +371,76 @@ TEST(InsideMasks, DeeplyNestedShellsAreExact) {
     }
   }
   EXPECT_GT(inside, 100);
+}
+
+// The ray path's exact integers against an independent reference: soups of random closed
+// tetrahedra (some inverted, some flat on a line, some repeated) with corners on the half-integer
+// lattice, so that voxel centres fall on faces, edges and corners. Reference: per tetrahedron,
+// whether the voxel centre displaced by -(e1, e2, e3), e1 >> e2 >> e3 > 0 (the crossings'
+// convention), is behind all four faces (exact orient3d; a zero decided by the perturbation,
+// which adds e . ((b - a) x (c - a))), counted with the tetrahedron's orientation.
+TEST(InsideMasks, RandomTetrahedraOnTheLatticeMatchAPointInTetrahedronReference) {
+  auto behind = [](const Vec3d& a, const Vec3d& b, const Vec3d& c, const Vec3d& p) {
+    const int s = orient3d_sign(a, b, c, p);
+    if (s != 0) return s > 0;
+    // The perturbation's terms: the normal's components, x first (exact signs by orient2d).
+    const int nx = orient2d_sign(a.y, a.z, b.y, b.z, c.y, c.z);
+    const int ny = orient2d_sign(a.z, a.x, b.z, b.x, c.z, c.x);
+    const int nz = orient2d_sign(a.x, a.y, b.x, b.y, c.x, c.y);
+    return (nx != 0 ? nx : (ny != 0 ? ny : nz)) > 0;
+  };
+  std::mt19937 rng(21);
+  std::uniform_int_distribution<int> L(0, 24);  // half-integer lattice over [0, 12]
+  std::size_t checked = 0, inside_total = 0, deep = 0;
+  for (int trial = 0; trial < 12; ++trial) {
+    struct Tet {
+      Vec3d v[4];
+      int orientation;
+    };
+    std::vector<Tet> tets;
+    for (int i = 0; i < 25; ++i) {
+      Tet t;
+      for (auto& v : t.v) v = {0.5 * L(rng), 0.5 * L(rng), 0.5 * L(rng)};
+      if (i % 9 == 4) {  // flat: all corners on one line (every face without area)
+        t.v[2] = (t.v[0] + t.v[1]) * 0.5;
+        t.v[3] = t.v[0] * 2.0 - t.v[1];
+      }
+      // Positive orientation: v3 behind face (v0, v1, v2) (swap two corners otherwise).
+      if (orient3d_sign(t.v[0], t.v[1], t.v[2], t.v[3]) < 0) std::swap(t.v[1], t.v[2]);
+      t.orientation = (rng() % 4 == 0) ? -1 : 1;
+      tets.push_back(t);
+      if (i % 7 == 3) tets.push_back(t);  // repeated
+    }
+    TriangleMesh soup;
+    for (const Tet& t : tets) {
+      const auto base = std::uint32_t(soup.vertices.size());
+      for (const auto& v : t.v) soup.vertices.push_back(v);
+      // Faces turning counterclockwise seen from outside (the opposite corner behind them).
+      const std::array<std::array<std::uint32_t, 3>, 4> faces = {{{0, 1, 2}, {0, 3, 1}, {1, 3, 2}, {0, 2, 3}}};
+      for (auto f : faces) {
+        if (t.orientation < 0) std::swap(f[1], f[2]);
+        soup.triangles.push_back({base + f[0], base + f[1], base + f[2]});
+      }
+    }
+    const Masks m = compute(soup, 1.0, {0, 0, 0}, 1.0);
+    ASSERT_EQ(m.result.open_edges, 0u) << trial;
+    m.for_each_voxel([&](const Vec3d& p, const Coord&, bool bit) {
+      int w = 0;
+      for (const Tet& t : tets) {
+        const Vec3d* v = t.v;
+        const bool in = behind(v[0], v[1], v[2], p) && behind(v[0], v[3], v[1], p) &&
+                        behind(v[1], v[3], v[2], p) && behind(v[0], v[2], v[3], p);
+        w += in ? t.orientation : 0;
+      }
+      ASSERT_EQ(bit, w >= 1) << "trial " << trial << " at " << p.x << " " << p.y << " " << p.z << " w " << w;
+      ++checked;
+      inside_total += bit;
+      deep += w >= 2;
+    });
+  }
+  EXPECT_GT(checked, 50000u);
+  EXPECT_GT(inside_total, 1000u);
+  EXPECT_GT(deep, 50u);
 }
 
 TEST(InsideMasks, FlippedFacesAfterOrientationGiveIdenticalMasks) {
