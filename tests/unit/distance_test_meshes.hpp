@@ -36,6 +36,15 @@ inline TriangleMesh box_mesh(const Vec3d& lo, const Vec3d& hi) {
   return m;
 }
 
+// Appends part's vertices and triangles to `into` (faces reversed when asked): soups of parts.
+inline void append_mesh(TriangleMesh& into, const TriangleMesh& part, bool reversed = false) {
+  const auto base = std::uint32_t(into.vertices.size());
+  into.vertices.insert(into.vertices.end(), part.vertices.begin(), part.vertices.end());
+  for (const auto& f : part.triangles)
+    into.triangles.push_back(reversed ? std::array<std::uint32_t, 3>{f[0] + base, f[2] + base, f[1] + base}
+                                      : std::array<std::uint32_t, 3>{f[0] + base, f[1] + base, f[2] + base});
+}
+
 // Exact unsigned distance to a mesh by brute force over all triangles (reference).
 inline double brute_force_distance(const TriangleMesh& m, const Vec3d& p) {
   double best = std::numeric_limits<double>::infinity();

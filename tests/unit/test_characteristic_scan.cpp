@@ -135,10 +135,7 @@ TEST(CharacteristicScan, EqualsTheSlabScanOnDenseMeshes) {
 // A sphere inside a box, a thin slab, a torus: polyhedra of separate sheets overlap in the band.
 TEST(CharacteristicScan, SeparateSheetsAndThinParts) {
   TriangleMesh mesh = test::icosphere(4, 0.3, {0, 0, 0});
-  const TriangleMesh box = test::box_mesh({-0.5, -0.5, -0.5}, {0.5, 0.5, 0.5});
-  const auto base = std::uint32_t(mesh.vertices.size());
-  mesh.vertices.insert(mesh.vertices.end(), box.vertices.begin(), box.vertices.end());
-  for (const auto& f : box.triangles) mesh.triangles.push_back({f[0] + base, f[1] + base, f[2] + base});
+  test::append_mesh(mesh, test::box_mesh({-0.5, -0.5, -0.5}, {0.5, 0.5, 0.5}));
   for (const double w : {3.0, 12.0})
     expect_same("sphere in box W=" + std::to_string(int(w)),
                 compare_methods(mesh, frame_for_resolution(mesh.bounds(), 80, w)));

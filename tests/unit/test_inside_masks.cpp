@@ -44,14 +44,18 @@ struct Masks {
   }
 };
 
+BrickTriangleLists lists_for(const TriangleMesh& mesh, const GridFrame& frame, double margin) {
+  BinTrianglesOptions bin;
+  bin.frame = frame;
+  bin.margin = margin;
+  return bin_triangles_to_bricks(mesh, bin);
+}
+
 Masks compute(const TriangleMesh& oriented, double h, Vec3d origin, double margin_voxels = 3.0) {
   Masks m;
   m.frame.voxel_size = h;
   m.frame.origin = origin;
-  BinTrianglesOptions bin;
-  bin.frame = m.frame;
-  bin.margin = margin_voxels * h;
-  m.lists = bin_triangles_to_bricks(oriented, bin);
+  m.lists = lists_for(oriented, m.frame, margin_voxels * h);
   const WindingNumberTree tree = build_winding_tree(oriented);
   InsideMasksOptions options;
   options.frame = m.frame;
@@ -271,9 +275,7 @@ TEST(InsideMasks, OverlappingSpheresSoupIsTheirUnion) {
   const Vec3d ca{0.02, 0.01, -0.03}, cb{0.83, 0.21, 0.07};
   TriangleMesh soup = test::icosphere(3, 1.0, ca);
   const TriangleMesh b = test::icosphere(3, 0.8, cb);
-  const std::uint32_t off = std::uint32_t(soup.vertices.size());
-  soup.vertices.insert(soup.vertices.end(), b.vertices.begin(), b.vertices.end());
-  for (auto f : b.triangles) soup.triangles.push_back({f[0] + off, f[1] + off, f[2] + off});
+  test::append_mesh(soup, b);
   const TriangleMesh a = test::icosphere(3, 1.0, ca);
   const WindingNumberTree ta = build_winding_tree(a), tb = build_winding_tree(b);
   const Masks m = compute(soup, 0.08, {0, 0, 0});
@@ -292,13 +294,7 @@ TEST(InsideMasks, OverlappingSpheresSoupIsTheirUnion) {
 // ray; with no ray budget the tree path takes over and gives the same masks.
 TEST(InsideMasks, ClosedSoupsInSeparateGroupsAndTheRayBudget) {
   TriangleMesh soup;
-  auto append = [&](TriangleMesh part, bool inward) {
-    const std::uint32_t off = std::uint32_t(soup.vertices.size());
-    soup.vertices.insert(soup.vertices.end(), part.vertices.begin(), part.vertices.end());
-    for (auto f : part.triangles)
-      soup.triangles.push_back(inward ? std::array<std::uint32_t, 3>{f[0] + off, f[2] + off, f[1] + off}
-                                      : std::array<std::uint32_t, 3>{f[0] + off, f[1] + off, f[2] + off});
-  };
+  auto append = [&](const TriangleMesh& part, bool inward) { test::append_mesh(soup, part, inward); };
   const Vec3d c{0.013, -0.021, 0.017}, far{5.03, 0.11, -0.07}, over{0.97, 0.05, 0.02};
   append(test::icosphere(3, 1.0, c), false);
   append(test::icosphere(3, 0.5, c), true);
@@ -342,17 +338,11 @@ TEST(InsideMasks, DeeplyNestedShellsAreExact) {
   TriangleMesh soup;
   for (int k = 0; k < 70; ++k) {
     const double r = 0.3 + 0.04 * k;
-    const TriangleMesh cube = test::box_mesh({3.5 - r, 3.52 - r, 3.54 - r}, {3.5 + r, 3.52 + r, 3.54 + r});
-    const auto base = std::uint32_t(soup.vertices.size());
-    soup.vertices.insert(soup.vertices.end(), cube.vertices.begin(), cube.vertices.end());
-    for (const auto& f : cube.triangles) soup.triangles.push_back({f[0] + base, f[1] + base, f[2] + base});
+    test::append_mesh(soup, test::box_mesh({3.5 - r, 3.52 - r, 3.54 - r}, {3.5 + r, 3.52 + r, 3.54 + r}));
   }
   GridFrame frame;
   frame.voxel_size = 1.0;
-  BinTrianglesOptions bin;
-  bin.frame = frame;
-  bin.margin = 1.0;
-  const BrickTriangleLists lists = bin_triangles_to_bricks(soup, bin);
+  const BrickTriangleLists lists = lists_for(soup, frame, 1.0);
   InsideMasksOptions options;
   options.frame = frame;
   const InsideMasksResult r = compute_inside_masks(soup, build_winding_tree(soup), lists, options);
@@ -508,10 +498,7 @@ TEST(InsideMasks, CancelsAndRejectsInconsistentInput) {
   const TriangleMesh sphere = test::icosphere(3);
   GridFrame frame;
   frame.voxel_size = 0.05;
-  BinTrianglesOptions bin;
-  bin.frame = frame;
-  bin.margin = 0.15;
-  const BrickTriangleLists lists = bin_triangles_to_bricks(sphere, bin);
+  const BrickTriangleLists lists = lists_for(sphere, frame, 0.15);
   const WindingNumberTree tree = build_winding_tree(sphere);
   InsideMasksOptions options;
   options.frame = frame;
