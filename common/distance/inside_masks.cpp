@@ -214,14 +214,12 @@ std::optional<std::vector<BrickMask>> closed_masks(std::span<const GridTriangle>
     });
     options.progress.step(0.9 * double(end) / double(nb), "sign");
   }
-  // Face-connected groups, each base relative to its group's first brick.
-  std::vector<std::vector<std::pair<std::size_t, int>>> links(nb);  // (neighbour, w change)
+  // Face-connected groups, each base relative to its group's first brick. The -axis
+  // neighbours are the +axis links read backwards.
+  std::vector<std::array<std::size_t, 3>> prev(nb, {nb, nb, nb});
   for (std::size_t i = 0; i < nb; ++i)
     for (int a = 0; a < 3; ++a)
-      if (bricks[i].next[a] != nb) {
-        links[i].push_back({bricks[i].next[a], bricks[i].step[a]});
-        links[bricks[i].next[a]].push_back({i, -bricks[i].step[a]});
-      }
+      if (bricks[i].next[a] != nb) prev[bricks[i].next[a]][a] = i;
   constexpr std::size_t kNone = ~std::size_t{0};
   std::vector<std::size_t> group(nb, kNone);
   std::vector<int> base(nb, 0);
@@ -234,7 +232,10 @@ std::optional<std::vector<BrickMask>> closed_masks(std::span<const GridTriangle>
     while (!queue.empty()) {
       const std::size_t i = queue.back();
       queue.pop_back();
-      for (const auto& [j, change] : links[i]) {
+      for (int a = 0; a < 6; ++a) {
+        const std::size_t j = a < 3 ? bricks[i].next[a] : prev[i][a - 3];
+        if (j == nb) continue;
+        const int change = a < 3 ? bricks[i].step[a] : -bricks[j].step[a - 3];
         if (group[j] != kNone) {
           if (base[j] != base[i] + change) return std::nullopt;
           continue;
