@@ -2,145 +2,188 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <vector>
 
-#include <tbb/blocked_range.h>
-#include <tbb/parallel_for.h>
-#include <tbb/parallel_invoke.h>
-
-#include "distance/eikonal_trial_queue.hpp"
+#include "distance/eikonal_rounds.hpp"
+#include "distance/eikonal_trial_heap.hpp"
 #include "distance/eikonal_update.hpp"
+#include "distance/redistance_tile.hpp"
 
 namespace levelset::detail {
 
 namespace {
 
-// Face neighbour of voxel n of brick b in direction dir (Face order); false outside.
-inline bool step(const RedistanceDomain& w, std::uint32_t& b, int& n, int dir) {
-  const int shift = 3 * (dir >> 1);
-  const int c = (n >> shift) & 7;
-  if (c == ((dir & 1) ? 7 : 0)) {
-    b = w.nbr[b][dir];
-    n ^= 7 << shift;
-    return b != kNoBrick;
-  }
-  n += (dir & 1) ? (1 << shift) : -(1 << shift);
-  return true;
-}
+// Per tile voxel: its input sign, whether it is an interface voxel, whether the march may set
+// it (a free voxel of the brick itself), whether its value is known (fixed and boundary
+// voxels from the start, the brick's own when accepted) and whether it waits in the heap.
+enum : std::uint8_t { kInsideBit = 1, kFixedBit = 2, kFreeBit = 4, kKnownBit = 8, kTrialBit = 16 };
 
-// During the march w.dist holds, per voxel: its distance once fixed or accepted (>= 0), minus its
-// tentative value while it is in the trial set (< 0), +inf otherwise: one array, so that a pop
-// touches one cache line per voxel rather than two (the march's cost is its cache misses: it
-// visits the front in value order, all over the surface).
-// (signbit: a tentative value of 0 is stored as -0.)
-inline bool tentative(float v) { return std::signbit(v); }
-inline bool known(float v) { return !std::signbit(v) && v < kInf; }
+template <int Halo>
+struct MarchTile {
+  using G = TileGeom<Halo>;
+  alignas(64) float val[G::kVoxels];
+  alignas(64) std::uint8_t st[G::kVoxels];
+};
 
-// Upwind update from the accepted neighbours on the voxel's
-// own side of the interface or fixed. (Only a band whose sign changes outside its active voxels
-// has a free neighbour of the other side; skipping it keeps the two sides' marches apart.)
-inline float known_update(const RedistanceDomain& w, std::uint32_t b, int n, bool second_order) {
-  const bool inside = w.inside[b].test(n);
+// Upwind update of tile voxel t from the known voxels on its own side of the interface and
+// the fixed ones (a side's march never reads the other side's free voxels). Second order:
+// the next value along the same direction, signed relative to the voxel.
+template <int Halo>
+inline float tile_update(const MarchTile<Halo>& m, int t, bool second) {
+  using G = TileGeom<Halo>;
+  const std::uint8_t side = m.st[t] & kInsideBit;
+  auto usable = [&](int u) {
+    const std::uint8_t s = m.st[u];
+    return (s & kKnownBit) && ((s & kInsideBit) == side || (s & kFixedBit));
+  };
   AxisTerm terms[3];
   for (int a = 0; a < 3; ++a) {
+    const int st = G::kStride[a];
     float m1 = kInf, m2 = kInf;
-    for (int s = 0; s < 2; ++s) {
-      std::uint32_t b1 = b;
-      int n1 = n;
-      if (!step(w, b1, n1, 2 * a + s)) continue;
-      if (w.inside[b1].test(n1) != inside && !w.fixed[b1].test(n1)) continue;
-      const float v1 = w.values(b1)[n1];
-      if (!known(v1) || !(v1 < m1)) continue;
-      m1 = v1;
+    for (int dir : {-st, st}) {
+      const int t1 = t + dir;
+      if (!usable(t1) || !(m.val[t1] < m1)) continue;
+      m1 = m.val[t1];
       m2 = kInf;
-      if (second_order && step(w, b1, n1, 2 * a + s) && (w.inside[b1].test(n1) == inside || w.fixed[b1].test(n1))) {
-        const float v2 = w.values(b1)[n1];
-        if (known(v2)) m2 = w.inside[b1].test(n1) == inside ? v2 : -v2;
+      if constexpr (Halo >= 2) {
+        const int t2 = t1 + dir;
+        if (second && usable(t2)) m2 = (m.st[t2] & kInsideBit) == side ? m.val[t2] : -m.val[t2];
       }
     }
-    terms[a] = axis_term(m1, m2, second_order && std::abs(m2) < kInf);
+    terms[a] = axis_term(m1, m2, second && std::abs(m2) < kInf);
   }
   return solve_terms(terms[0], terms[1], terms[2]);
 }
 
-// Accepts the voxels of one side (inside or not) smallest tentative value first.
-void march_side(RedistanceDomain& w, TrialQueue& trial, bool inside, bool second, const ProgressHook& progress) {
-  std::uint64_t pops = 0;
-  HeapEntry e;
-  while (trial.pop(e)) {
-    if ((++pops & 0xffff) == 0) progress.check("redistance march");
-    if (!tentative(w.dist[e.id])) continue;  // accepted earlier with a smaller value
-    w.dist[e.id] = e.value;
-    if (const HeapEntry* next = trial.peek()) {  // its voxel's line and masks arrive meanwhile
-      __builtin_prefetch(&w.dist[next->id]);
-      __builtin_prefetch(&w.inside[next->id / kBrickVoxels]);
+// Whether the brick across face f of brick b may read voxel n of b (within Halo voxels of
+// the face), now or before a change, with lo = the smaller of its old and new value. Only
+// the voxel adjacent to the face on the same line reads it (depth 0 as its upwind neighbour,
+// depth 1 as the next value behind that one), and only when it is upwind of that voxel's
+// value: at most that value. (The voxel behind the adjacent one reads depth 0 as a next
+// value only when it continues monotonically, i.e. at most the adjacent voxel's value.)
+// The neighbour's values are read while no kernel writes them (it is of the other colour).
+// A change that nobody reads needs no re-march.
+bool neighbour_reads(const RedistanceDomain& w, std::uint32_t b, int n, int f, float lo) {
+  const std::uint32_t nb = w.nbr[b][f];
+  if (nb == kNoBrick) return false;
+  const int shift = 3 * (f >> 1);
+  const int adjacent = (f & 1) ? 0 : kBrickDim - 1;  // the neighbour's coordinate next to the face
+  return lo <= w.values(nb)[(n & ~(7 << shift)) | adjacent << shift];
+}
+
+// Fast marching inside brick b (see march() in the header): the tile holds the brick's fixed
+// voxels and its face neighbours' current values (`Halo` layers deep) as boundary data, known
+// from the start and never changed. The brick's free voxels are recomputed from scratch; the
+// result says which faces' neighbours read a value that changed.
+template <int Halo>
+BrickPass march_brick(RedistanceDomain& w, std::uint32_t b, const BrickMask& free_mask, bool second, float limit,
+                      float tolerance, TrialHeap& scratch) {
+  using G = TileGeom<Halo>;
+  MarchTile<Halo> m;
+  std::fill(m.val, m.val + G::kVoxels, kInf);
+  std::fill(m.st, m.st + G::kVoxels, std::uint8_t{0});
+  TrialHeap& heap = scratch;
+  heap.clear();
+  auto put = [&](std::uint32_t src, int n, int t, bool own) {
+    std::uint8_t s = w.inside[src].test(n) ? kInsideBit : 0;
+    const float v = w.values(src)[n];
+    if (w.fixed[src].test(n)) {
+      s |= kFixedBit | kKnownBit;
+      m.val[t] = v;
+    } else if (own) {
+      if (free_mask.test(n)) s |= kFreeBit;
+    } else if (v <= limit) {
+      s |= kKnownBit;
+      m.val[t] = v;
     }
-    const std::uint32_t b = e.id / kBrickVoxels;
-    const int v = int(e.id % kBrickVoxels);
-    for (int dir = 0; dir < 6; ++dir) {
-      std::uint32_t b2 = b;
-      int n2 = v;
-      if (!step(w, b2, n2, dir) || !w.domain[b2].test(n2) || w.inside[b2].test(n2) != inside) continue;
-      const std::uint32_t id2 = b2 * std::uint32_t(kBrickVoxels) + std::uint32_t(n2);
-      const float d = w.dist[id2];
-      if (known(d)) continue;  // fixed or accepted
-      const float t = known_update(w, b2, n2, second);
-      if (d == kInf || t < -d) {
-        w.dist[id2] = -t;
-        trial.push({t, id2});
-      }
+    m.st[t] = s;
+  };
+  for (int n = 0; n < kBrickVoxels; ++n) put(b, n, kTileGeom<Halo>.tile_of[n], true);
+  for (int f = 0; f < 6; ++f) {
+    const std::uint32_t nb = w.nbr[b][f];
+    if (nb == kNoBrick) continue;
+    const int axis = f >> 1;
+    for (int layer = 0; layer < Halo; ++layer) {
+      const int mine = (f & 1) ? kBrickDim + layer : -1 - layer;  // tile coordinate on axis
+      const int theirs = (f & 1) ? layer : kBrickDim - 1 - layer;
+      for (int j = 0; j < kBrickDim; ++j)
+        for (int i = 0; i < kBrickDim; ++i) {
+          int c[3];
+          c[axis] = theirs;
+          c[axis == 0 ? 1 : 0] = i;
+          c[axis == 2 ? 1 : 2] = j;
+          int tc[3] = {c[0], c[1], c[2]};
+          tc[axis] = mine;
+          put(nb, local_index(c[0], c[1], c[2]), G::index(tc[0], tc[1], tc[2]), false);
+        }
     }
   }
+  // A better tentative value v for free voxel t.
+  auto offer = [&](int t, float v) {
+    if (!(v < m.val[t]) || !(v <= limit)) return;
+    m.val[t] = v;
+    const std::uint64_t k = trial_key(v, t);
+    if (m.st[t] & kTrialBit) {
+      heap.decrease(k);
+    } else {
+      m.st[t] |= kTrialBit;
+      heap.push(k);
+    }
+  };
+  // The front: free voxels next to a fixed or a halo voxel, from those alone.
+  free_mask.for_each_set([&](int n) {
+    const int t = kTileGeom<Halo>.tile_of[n];
+    for (int a = 0; a < 3; ++a)
+      if ((m.st[t - G::kStride[a]] | m.st[t + G::kStride[a]]) & kKnownBit) {
+        offer(t, tile_update(m, t, second));
+        return;
+      }
+  });
+  while (!heap.empty()) {
+    const int t = key_tile(heap.pop());
+    m.st[t] = std::uint8_t((m.st[t] & ~kTrialBit) | kKnownBit);
+    const std::uint8_t side = m.st[t] & kInsideBit;
+    for (int a = 0; a < 3; ++a)
+      for (int dir : {-G::kStride[a], G::kStride[a]}) {
+        const int t2 = t + dir;
+        const std::uint8_t s2 = m.st[t2];
+        if ((s2 & (kFreeBit | kKnownBit)) != kFreeBit || (s2 & kInsideBit) != side) continue;
+        offer(t2, tile_update(m, t2, second));
+      }
+  }
+  BrickPass pass;
+  float* own = w.values(b);
+  free_mask.for_each_set([&](int n) {
+    const int t = kTileGeom<Halo>.tile_of[n];
+    const float v = (m.st[t] & kKnownBit) ? m.val[t] : kInf;
+    const float old = own[n];
+    own[n] = v;
+    if (v == old) return;
+    const float change = (v == kInf || old == kInf) ? kInf : std::abs(v - old);
+    if (!(change >= tolerance)) return;
+    pass.max_change = std::max(pass.max_change, change);
+    const float lo = std::min(v, old);
+    for (std::uint8_t faces = kTileGeom<Halo>.faces[n]; faces != 0; faces &= std::uint8_t(faces - 1)) {
+      const int f = std::countr_zero(faces);
+      if (neighbour_reads(w, b, n, f, lo)) pass.changed_faces |= std::uint8_t(1u << f);
+    }
+  });
+  return pass;
 }
 
 }  // namespace
 
-void march(RedistanceDomain& w, int order, double limit, const ProgressHook& progress) {
-  const std::size_t n = w.size();
+int march(RedistanceDomain& w, int order, double limit, float tolerance, const ProgressHook& progress) {
   const bool second = order == 2;
-  // Initial front: free voxels next to an interface voxel, per brick in parallel.
-  std::vector<std::vector<HeapEntry>> front(n);
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 16), [&](const tbb::blocked_range<std::size_t>& r) {
-    for (std::size_t bi = r.begin(); bi != r.end(); ++bi) {
-      const auto b = std::uint32_t(bi);
-      const float* own = w.values(b);
-      w.domain[b].for_each_set([&](int v) {
-        if (own[v] < kInf) return;  // interface voxel
-        bool near = false;
-        for (int dir = 0; dir < 6 && !near; ++dir) {
-          std::uint32_t b2 = b;
-          int n2 = v;
-          near = step(w, b2, n2, dir) && w.values(b2)[n2] < kInf;
-        }
-        if (!near) return;
-        front[b].push_back({known_update(w, b, v, second), b * std::uint32_t(kBrickVoxels) + std::uint32_t(v)});
-      });
-    }
-  });
-  // The two sides of the interface march apart (each reads only its own side and the fixed
-  // interface voxels: a free voxel next to the other side would be an interface voxel), so
-  // they run in parallel and give what one march over both gives.
-  TrialQueue trial[2] = {TrialQueue(limit), TrialQueue(limit)};
-  {
-    std::vector<HeapEntry> sides[2];
-    for (const auto& f : front)
-      for (const HeapEntry& e : f) {
-        // Marked tentative only now: the front's updates above read the fixed voxels alone.
-        if (e.value < kInf) w.dist[e.id] = -e.value;
-        sides[w.inside[e.id / kBrickVoxels].test(int(e.id % kBrickVoxels)) ? 1 : 0].push_back(e);
-      }
-    front = {};
-    trial[0].assign(sides[0]);
-    trial[1].assign(sides[1]);
-  }
-  tbb::parallel_invoke([&] { march_side(w, trial[0], false, second, progress); },
-                       [&] { march_side(w, trial[1], true, second, progress); });
-  // Voxels left in the trial set (beyond the limit) are unknown.
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, w.dist.size(), 1 << 16),
-                    [&](const tbb::blocked_range<std::size_t>& r) {
-                      for (std::size_t i = r.begin(); i != r.end(); ++i)
-                        if (tentative(w.dist[i])) w.dist[i] = kInf;
-                    });
+  const std::vector<BrickMask> free_mask = free_masks(w);
+  const float lim = float(limit);
+  return brick_rounds(w, free_mask, kMaxMarchRounds, tolerance, "redistance march", progress,
+                      [&](std::uint32_t b, std::uint8_t) {
+                        thread_local TrialHeap scratch;
+                        return second ? march_brick<2>(w, b, free_mask[b], true, lim, tolerance, scratch)
+                                      : march_brick<1>(w, b, free_mask[b], false, lim, tolerance, scratch);
+                      });
 }
 
 }  // namespace levelset::detail

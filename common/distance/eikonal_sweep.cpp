@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <array>
-#include <atomic>
 #include <bit>
 #include <cmath>
 #include <vector>
@@ -10,6 +9,7 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
+#include "distance/eikonal_rounds.hpp"
 #include "distance/eikonal_update.hpp"
 #include "distance/redistance_tile.hpp"
 
@@ -114,11 +114,6 @@ BrickMask face_layer(int f, int depth) {
   return m;
 }
 
-struct BrickSweep {
-  float max_change = 0.0f;
-  std::uint8_t changed_faces = 0;  // faces whose layers within the stencil reach changed
-};
-
 // One ordered Gauss-Seidel pass over the dirty free voxels: update(n) for each voxel n that
 // is dirty when its turn comes, its dirty bit cleared first. order_mask is the free mask
 // permuted for the ordering and x its flip_xor (bit position ^ x = voxel). update may mark
@@ -141,7 +136,7 @@ inline void for_each_dirty(const BrickMask& order_mask, int x, BrickMask& dirty,
 // A value moved by `change`: the brick's largest change, the faces whose neighbours read it
 // (`faces`, from TileGeom<Reach>) and the voxels whose stencil holds it (dirty again).
 template <int Reach>
-inline void record_change(int n, float change, std::uint8_t faces, BrickMask& dirty, BrickSweep& s) {
+inline void record_change(int n, float change, std::uint8_t faces, BrickMask& dirty, BrickPass& s) {
   s.max_change = std::max(s.max_change, change);
   s.changed_faces |= faces;
   mark_dependents<Reach>(dirty, n);
@@ -149,7 +144,7 @@ inline void record_change(int n, float change, std::uint8_t faces, BrickMask& di
 
 // First order: monotone (values only decrease, T = min(T, update)); a voxel's dependents
 // are marked on any decrease. One ordered Gauss-Seidel sweep over the dirty free voxels.
-void sweep_first(float* tile, const BrickMask& order_mask, int x, BrickMask& dirty, BrickSweep& s) {
+void sweep_first(float* tile, const BrickMask& order_mask, int x, BrickMask& dirty, BrickPass& s) {
   constexpr int dy = TileGeom<1>::kDim, dz = dy * dy;
   for_each_dirty(order_mask, x, dirty, [&](int n) {
     const int t = kGeom1.tile_of[n];
@@ -165,7 +160,7 @@ void sweep_first(float* tile, const BrickMask& order_mask, int x, BrickMask& dir
 // Second order on a signed tile: not monotone, so no min with the old value; dependents are
 // marked when a value moves, by the tolerance or more.
 void sweep_second(float* tile, const BrickMask& order_mask, int x, float tolerance, BrickMask& dirty,
-                  BrickSweep& s) {
+                  BrickPass& s) {
   using G = TileGeom<2>;
   for_each_dirty(order_mask, x, dirty, [&](int n) {
     const int t = kGeom2.tile_of[n];
@@ -194,12 +189,12 @@ void sweep_second(float* tile, const BrickMask& order_mask, int x, float toleran
 // Up to 8 ordered sweeps of one brick (fewer once no voxel is dirty) on a tile with the
 // face neighbours' current values, starting with the pair `first` and its opposite. `dirty`
 // persists between iterations.
-BrickSweep sweep_brick(RedistanceDomain& w, std::uint32_t b, const BrickMask& free_mask, BrickMask& dirty, bool second,
+BrickPass sweep_brick(RedistanceDomain& w, std::uint32_t b, const BrickMask& free_mask, BrickMask& dirty, bool second,
                        float tolerance, int first) {
   int order[8] = {first, first ^ 7};
   for (int k = 0, o = 2; k < 8; ++k)
     if (kOrderings[k] != first && kOrderings[k] != (first ^ 7)) order[o++] = kOrderings[k];
-  BrickSweep s;
+  BrickPass s;
   float* own = w.values(b);
   auto pending = [&] {
     std::uint64_t any = 0;
@@ -257,66 +252,25 @@ std::vector<std::uint8_t> first_orderings(const RedistanceDomain& w) {
 
 }  // namespace
 
-// Sweeps bricks with work in two checkerboard colours until an iteration's largest change is
-// below the tolerance, nothing is left to do, or `max_iterations` ran. Returns iterations.
+// Sweeps bricks with work (brick_rounds) until a round's largest change is below the
+// tolerance, nothing is left to do, or `max_iterations` ran. Returns iterations.
 int sweep(RedistanceDomain& w, int order, int max_iterations, float tolerance, const ProgressHook& progress) {
-  const std::size_t n = w.size();
   const bool second = order == 2;
   const int reach = second ? 2 : 1;
-  std::vector<BrickMask> free_mask(n), dirty(n);
-  std::vector<std::uint32_t> colour[2];
-  for (std::uint32_t b = 0; b < n; ++b) {
-    for (int k = 0; k < 8; ++k) free_mask[b].words[k] = w.domain[b].words[k] & ~w.fixed[b].words[k];
-    if (free_mask[b].none()) continue;
-    dirty[b] = free_mask[b];
-    const Coord c = w.coords[b];
-    colour[(c.x + c.y + c.z) & 1].push_back(b);
-  }
+  const std::vector<BrickMask> free_mask = free_masks(w);
+  std::vector<BrickMask> dirty = free_mask;
   const std::vector<std::uint8_t> first = first_orderings(w);
   BrickMask layers[6];
   for (int f = 0; f < 6; ++f) layers[f] = face_layer(f, reach);
-  // Per brick: bit f = the neighbour across face f changed its layer there; bit 6 = own work.
-  constexpr std::uint8_t kOwnWork = 1u << 6;
-  std::vector<std::atomic<std::uint8_t>> flags(n);
-  for (auto& f : flags) f.store(kOwnWork, std::memory_order_relaxed);
-  std::vector<float> change(n, 0.0f);
-  int iterations = 0;
-  while (iterations < max_iterations) {
-    bool any = false;
-    float max_change = 0.0f;
-    for (int c = 0; c < 2; ++c) {
-      const std::vector<std::uint32_t>& list = colour[c];
-      tbb::parallel_for(tbb::blocked_range<std::size_t>(0, list.size(), 4), [&](const tbb::blocked_range<std::size_t>& r) {
-        for (std::size_t i = r.begin(); i != r.end(); ++i) {
-          const std::uint32_t b = list[i];
-          change[b] = -1.0f;  // not swept
-          const std::uint8_t bits = flags[b].exchange(0, std::memory_order_relaxed);
-          if (bits == 0) continue;
-          for (int f = 0; f < 6; ++f)
-            if (bits >> f & 1)
-              for (int k = 0; k < 8; ++k) dirty[b].words[k] |= layers[f].words[k];
-          const BrickSweep s = sweep_brick(w, b, free_mask[b], dirty[b], second, tolerance, first[b]);
-          change[b] = s.max_change;
-          if (!dirty[b].none()) flags[b].fetch_or(kOwnWork, std::memory_order_relaxed);
-          for (int f = 0; f < 6; ++f) {
-            const std::uint32_t nb = w.nbr[b][f];
-            if ((s.changed_faces >> f & 1) && nb != kNoBrick)
-              flags[nb].fetch_or(std::uint8_t(1u << (f ^ 1)), std::memory_order_relaxed);
-          }
-        }
-      });
-      for (std::uint32_t b : list) {
-        if (change[b] < 0.0f) continue;
-        any = true;
-        max_change = std::max(max_change, change[b]);
-      }
-    }
-    if (!any) break;
-    ++iterations;
-    progress.step(0.1 + 0.8 * double(iterations) / max_iterations, "redistance sweep");
-    if (max_change < tolerance) break;
-  }
-  return iterations;
+  return brick_rounds(w, free_mask, max_iterations, tolerance, "redistance sweep", progress,
+                      [&](std::uint32_t b, std::uint8_t bits) {
+                        for (int f = 0; f < 6; ++f)
+                          if (bits >> f & 1)
+                            for (int k = 0; k < 8; ++k) dirty[b].words[k] |= layers[f].words[k];
+                        BrickPass s = sweep_brick(w, b, free_mask[b], dirty[b], second, tolerance, first[b]);
+                        s.more_work = !dirty[b].none();
+                        return s;
+                      });
 }
 
 }  // namespace levelset::detail

@@ -394,7 +394,7 @@ class Membranes {
         });
       }
     });
-    detail::march(w, 1, o_.frame.half_width, o_.progress);
+    detail::march(w, 1, o_.frame.half_width, 1e-6f, o_.progress);
     merge(w, dmesh, h);
   }
 

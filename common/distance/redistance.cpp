@@ -38,7 +38,7 @@ RedistanceResult redistance(const NarrowBand& in, const RedistanceOptions& optio
   validate(options);
   GridFrame frame = in.frame();
   if (options.half_width != 0.0) frame.half_width = options.half_width;
-  RedistanceResult result{NarrowBand(frame), 0, 0, 0.0};  // validates the new frame
+  RedistanceResult result{NarrowBand(frame), 0, 0, 0, 0.0};  // validates the new frame
   result.band.set_far_inside(in.far_inside());
   options.progress.step(0.0, "redistance");
   if (in.brick_count() > 0) {
@@ -51,7 +51,7 @@ RedistanceResult redistance(const NarrowBand& in, const RedistanceOptions& optio
       result.sweep_iterations = detail::sweep(w, options.order, options.max_sweep_iterations,
                                               float(options.tolerance), options.progress);
     } else {
-      detail::march(w, options.order, frame.half_width, options.progress);
+      result.march_rounds = detail::march(w, options.order, frame.half_width, float(options.tolerance), options.progress);
     }
     options.progress.step(0.9, "redistance assemble");
     result.band = detail::assemble_band(in, w, frame);

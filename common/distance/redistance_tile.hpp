@@ -6,7 +6,7 @@
 // TileGeom<Halo>: compile-time strides and index, plus per-voxel tables: tile_of[n] = the
 //   tile index of local voxel n, faces[n] bit f = n lies within Halo voxels of face f (Face
 //   order: -x, +x, -y, +y, -z, +z).
-// Cost: tables built at compile time (kGeom1, kGeom2). Threading: constant data.
+// Cost: tables built at compile time (kTileGeom<Halo>; kGeom1, kGeom2). Threading: constant data.
 #pragma once
 
 #include <array>
@@ -35,7 +35,9 @@ struct TileGeom {
     }
   }
 };
-inline constexpr TileGeom<1> kGeom1{};
-inline constexpr TileGeom<2> kGeom2{};
+template <int Halo>
+inline constexpr TileGeom<Halo> kTileGeom{};
+inline constexpr const TileGeom<1>& kGeom1 = kTileGeom<1>;
+inline constexpr const TileGeom<2>& kGeom2 = kTileGeom<2>;
 
 }  // namespace levelset::detail

@@ -234,7 +234,8 @@ bool run_case(int res, int runs, bench::RatioSummary& summary) {
         summary.add(what + " / sdfToSdf", 0.5, "R=" + std::to_string(res) + " thr=" + std::to_string(threads),
                     t / vdb_sweep_seconds[threads]);
         row(what.c_str(), res, threads, voxels, t, vdb_sweep_seconds[threads], q,
-            method == RedistanceMethod::Sweep ? std::to_string(r.sweep_iterations) + " iterations" : "");
+            method == RedistanceMethod::Sweep ? std::to_string(r.sweep_iterations) + " iterations"
+                                              : std::to_string(r.march_rounds) + " rounds");
       }
     }
   }

@@ -6,14 +6,16 @@
 #include <limits>
 #include <map>
 #include <memory>
+#include <random>
 #include <string>
 
 #include <tbb/task_arena.h>
 
 #include "core/error.hpp"
+#include "distance/eikonal_march.hpp"
+#include "distance/eikonal_trial_heap.hpp"
 #include "distance/redistance.hpp"
 #include "grid/band_accessor.hpp"
-#include "distance/eikonal_trial_queue.hpp"
 #include "grid/band_builder.hpp"
 #include "shape_band.hpp"
 
@@ -403,6 +405,31 @@ TEST(RedistanceMethods, SweepAndMarchAgree) {
   }
 }
 
+// A band grown to W = 12: characteristics cross up to two bricks beyond the interface's, so
+// the bricks' marches take several rounds to agree; first order, they reach the discrete
+// solution that the sweep (an independent solver, run to convergence) reaches.
+TEST(RedistanceMethods, MarchRoundsConvergeOnAWideBand) {
+  const auto sb = make_shape_band("torus", 96);
+  const NarrowBand in = distort(sb.band);
+  RedistanceOptions o;
+  o.order = 1;
+  o.half_width = 12.0;
+  o.max_sweep_iterations = 100;
+  o.tolerance = 0.0;
+  const RedistanceResult s = redistance(in, o);
+  o.method = RedistanceMethod::March;
+  const RedistanceResult m = redistance(in, o);
+  const BandDiff d = compare(s.band, m.band);
+  std::printf("[wide band, order 1] sweep %d iterations, march %d rounds; common %zu, max diff %.2e h, only in one %zu\n",
+              s.sweep_iterations, m.march_rounds, d.common, d.max_diff, d.only_one);
+  EXPECT_LT(s.sweep_iterations, o.max_sweep_iterations);
+  EXPECT_GE(m.march_rounds, 3);
+  EXPECT_LT(m.march_rounds, detail::kMaxMarchRounds);
+  EXPECT_LT(d.max_diff, 1e-5);
+  EXPECT_LE(d.only_one, s.band.active_voxel_count() / 10000);
+  EXPECT_GT(s.band.active_voxel_count(), 3 * in.active_voxel_count());
+}
+
 // The iteration cap and the tolerance: one iteration leaves work undone; tolerance 0 runs
 // to the exact fixed point, which the default tolerance (1e-6 h) matches closely.
 TEST(RedistanceSweep, IterationCapAndTolerance) {
@@ -569,65 +596,52 @@ TEST(RedistanceErrors, CancellationStopsTheWork) {
 namespace levelset {
 namespace {
 
-// The march pops a voxel, peeks at the next (to prefetch it), then pushes its neighbours: when
-// that pop emptied the queue, the pushes must still land in a slice that is popped later (they
-// were written past the last slice, a crash in the CPT's membranes of an open dense mesh).
-TEST(TrialQueue, PushAfterAnEmptyPeekIsPopped) {
-  detail::TrialQueue q(12.0);
-  q.push({0.5f, 7});
-  detail::HeapEntry e;
-  ASSERT_TRUE(q.pop(e));
-  EXPECT_EQ(e.id, 7u);
-  EXPECT_EQ(q.peek(), nullptr);
-  q.push({11.9f, 8});
-  q.push({1.5f, 9});
-  q.push({12.5f, 10});  // beyond the limit: never accepted
-  ASSERT_NE(q.peek(), nullptr);
-  ASSERT_TRUE(q.pop(e));
-  EXPECT_EQ(e.id, 9u);
-  ASSERT_TRUE(q.pop(e));
-  EXPECT_EQ(e.id, 8u);
-  EXPECT_FALSE(q.pop(e));
-  EXPECT_EQ(q.peek(), nullptr);
-  q.push({12.0f, 11});  // exactly the limit, after the queue ran dry at its last slice
-  ASSERT_TRUE(q.pop(e));
-  EXPECT_EQ(e.id, 11u);
+// Keys order by value, then tile index; -0 reads as 0.
+TEST(TrialHeap, KeysOrderByValueThenTile) {
+  using detail::trial_key;
+  EXPECT_LT(trial_key(0.0f, 5), trial_key(1e-30f, 0));
+  EXPECT_LT(trial_key(1.5f, 3), trial_key(1.5f, 4));
+  EXPECT_LT(trial_key(1.5f, 1727), trial_key(std::nextafter(1.5f, 2.0f), 0));
+  EXPECT_EQ(trial_key(-0.0f, 7), trial_key(0.0f, 7));
+  EXPECT_EQ(detail::key_tile(trial_key(2.25f, 1234)), 1234);
 }
 
-// A slice is sorted once it becomes current; values pushed into it afterwards (within 1/256
-// voxel of the one just accepted) still come out in order, merged with the sorted rest, and
-// equal values in id order.
-TEST(TrialQueue, PushesIntoTheCurrentSliceMergeInOrder) {
-  detail::TrialQueue q(4.0);
-  q.push({1.0f, 5});
-  q.push({1.003f, 6});
-  q.push({1.003f, 2});
-  q.push({2.5f, 7});
-  detail::HeapEntry e;
-  ASSERT_TRUE(q.pop(e));
-  EXPECT_EQ(e.id, 5u);
-  q.push({1.001f, 9});   // the current slice, after its sort
-  q.push({1.003f, 1});   // ties with two sorted entries: smallest id first
-  q.push({0.999f, 3});   // below the last pop (rounding): still the minimum now
-  std::vector<std::uint32_t> order;
-  while (q.pop(e)) order.push_back(e.id);
-  EXPECT_EQ(order, (std::vector<std::uint32_t>{3, 9, 1, 2, 6, 7}));
-}
-
-TEST(TrialQueue, PopsInValueOrderAcrossSlices) {
-  detail::TrialQueue q(6.0);
-  std::vector<float> values;
-  for (int i = 0; i < 2000; ++i) values.push_back(float((i * 7919) % 6000) / 1000.0f);
-  for (std::size_t i = 0; i < values.size(); ++i) q.push({values[i], std::uint32_t(i)});
-  float last = -1;
-  detail::HeapEntry e;
-  std::size_t n = 0;
-  while (q.pop(e)) {
-    EXPECT_GE(e.value, last);
-    last = e.value;
-    ++n;
+// Random pushes and decreases against a reference: pops come out in key order and each voxel
+// once, with its last (smallest) key.
+TEST(TrialHeap, PopsInKeyOrderWithDecreases) {
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<float> value(0.0f, 3.0f);
+  detail::TrialHeap heap;
+  for (int trial = 0; trial < 20; ++trial) {
+    heap.clear();
+    std::map<int, std::uint64_t> current;  // tile -> key in the heap
+    for (int op = 0; op < 2000; ++op) {
+      const int t = int(rng() % 512) * 3;  // tile indices spread over a halo-2 tile
+      const float v = value(rng);
+      const std::uint64_t k = detail::trial_key(v, t);
+      const auto it = current.find(t);
+      if (it == current.end()) {
+        if (current.size() == 512) continue;
+        heap.push(k);
+        current[t] = k;
+      } else if (k < it->second) {
+        heap.decrease(k);
+        it->second = k;
+      }
+      if (op % 7 == 0 && !heap.empty()) {  // interleaved pops: the smallest key
+        std::uint64_t smallest = ~std::uint64_t{0};
+        for (const auto& [tile, key] : current) smallest = std::min(smallest, key);
+        ASSERT_EQ(heap.pop(), smallest);
+        current.erase(detail::key_tile(smallest));
+      }
+    }
+    std::vector<std::uint64_t> expected;
+    for (const auto& [tile, key] : current) expected.push_back(key);
+    std::sort(expected.begin(), expected.end());
+    std::vector<std::uint64_t> popped;
+    while (!heap.empty()) popped.push_back(heap.pop());
+    EXPECT_EQ(popped, expected);
   }
-  EXPECT_EQ(n, values.size());
 }
 
 }  // namespace
