@@ -100,25 +100,7 @@ BrickPass march_brick(RedistanceDomain& w, std::uint32_t b, const BrickMask& fre
     m.st[t] = s;
   };
   for (int n = 0; n < kBrickVoxels; ++n) put(b, n, kTileGeom<Halo>.tile_of[n], true);
-  for (int f = 0; f < 6; ++f) {
-    const std::uint32_t nb = w.nbr[b][f];
-    if (nb == kNoBrick) continue;
-    const int axis = f >> 1;
-    for (int layer = 0; layer < Halo; ++layer) {
-      const int mine = (f & 1) ? kBrickDim + layer : -1 - layer;  // tile coordinate on axis
-      const int theirs = (f & 1) ? layer : kBrickDim - 1 - layer;
-      for (int j = 0; j < kBrickDim; ++j)
-        for (int i = 0; i < kBrickDim; ++i) {
-          int c[3];
-          c[axis] = theirs;
-          c[axis == 0 ? 1 : 0] = i;
-          c[axis == 2 ? 1 : 2] = j;
-          int tc[3] = {c[0], c[1], c[2]};
-          tc[axis] = mine;
-          put(nb, local_index(c[0], c[1], c[2]), G::index(tc[0], tc[1], tc[2]), false);
-        }
-    }
-  }
+  for_each_halo_voxel<Halo>(w.nbr[b], [&](std::uint32_t nb, int n, int t) { put(nb, n, t, false); });
   // A better tentative value v for free voxel t.
   auto offer = [&](int t, float v) {
     if (!(v < m.val[t]) || !(v <= limit)) return;

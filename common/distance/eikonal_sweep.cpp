@@ -45,29 +45,12 @@ template <int Halo, bool Signed>
 void load_tile(const RedistanceDomain& w, std::uint32_t b, float* tile) {
   using G = TileGeom<Halo>;
   std::fill(tile, tile + G::kVoxels, kInf);
-  auto put = [&](std::uint32_t src, int sx, int sy, int sz, int tx, int ty, int tz) {
-    const int n = local_index(sx, sy, sz);
+  auto put = [&](std::uint32_t src, int n, int t) {
     const float v = w.values(src)[n];
-    tile[G::index(tx, ty, tz)] = Signed && w.inside[src].test(n) ? -v : v;
+    tile[t] = Signed && w.inside[src].test(n) ? -v : v;
   };
-  for (int z = 0; z < kBrickDim; ++z)
-    for (int y = 0; y < kBrickDim; ++y)
-      for (int x = 0; x < kBrickDim; ++x) put(b, x, y, z, x, y, z);
-  for (int f = 0; f < 6; ++f) {
-    const std::uint32_t nb = w.nbr[b][f];
-    if (nb == kNoBrick) continue;
-    const int axis = f >> 1;
-    for (int layer = 0; layer < Halo; ++layer) {
-      const int mine = (f & 1) ? kBrickDim + layer : -1 - layer;  // tile coordinate on axis
-      const int theirs = (f & 1) ? layer : kBrickDim - 1 - layer;
-      for (int j = 0; j < kBrickDim; ++j)
-        for (int i = 0; i < kBrickDim; ++i) {
-          if (axis == 0) put(nb, theirs, i, j, mine, i, j);
-          if (axis == 1) put(nb, i, theirs, j, i, mine, j);
-          if (axis == 2) put(nb, i, j, theirs, i, j, mine);
-        }
-    }
-  }
+  for (int n = 0; n < kBrickVoxels; ++n) put(b, n, kTileGeom<Halo>.tile_of[n]);
+  for_each_halo_voxel<Halo>(w.nbr[b], put);
 }
 
 // Voxel-level work lists: a sweep evaluates only voxels whose stencil saw a change since

@@ -6,10 +6,12 @@
 // TileGeom<Halo>: compile-time strides and index, plus per-voxel tables: tile_of[n] = the
 //   tile index of local voxel n, faces[n] bit f = n lies within Halo voxels of face f (Face
 //   order: -x, +x, -y, +y, -z, +z).
+// for_each_halo_voxel<Halo>(nbr, f): visits the face neighbours' voxels that fill the halo.
 // Cost: tables built at compile time (kTileGeom<Halo>; kGeom1, kGeom2). Threading: constant data.
 #pragma once
 
 #include <array>
+#include <cstddef>
 #include <cstdint>
 
 #include "grid/coord.hpp"
@@ -37,6 +39,30 @@ struct TileGeom {
 };
 template <int Halo>
 inline constexpr TileGeom<Halo> kTileGeom{};
+
+// f(neighbour brick, its local voxel index, tile index) for every voxel of the `Halo` layers
+// that the face neighbours nbr (Face order, kNoBrick: none) contribute to the tile.
+template <int Halo, typename F>
+void for_each_halo_voxel(const std::array<std::uint32_t, 6>& nbr, F&& f) {
+  for (int face = 0; face < 6; ++face) {
+    const std::uint32_t nb = nbr[std::size_t(face)];
+    if (nb == kNoBrick) continue;
+    const int axis = face >> 1, u = axis == 0 ? 1 : 0, v = axis == 2 ? 1 : 2;
+    for (int layer = 0; layer < Halo; ++layer) {
+      const int mine = (face & 1) ? kBrickDim + layer : -1 - layer;  // tile coordinate on axis
+      const int theirs = (face & 1) ? layer : kBrickDim - 1 - layer;
+      for (int j = 0; j < kBrickDim; ++j)
+        for (int i = 0; i < kBrickDim; ++i) {
+          int c[3], t[3];
+          c[axis] = theirs;
+          t[axis] = mine;
+          c[u] = t[u] = i;
+          c[v] = t[v] = j;
+          f(nb, local_index(c[0], c[1], c[2]), TileGeom<Halo>::index(t[0], t[1], t[2]));
+        }
+    }
+  }
+}
 inline constexpr const TileGeom<1>& kGeom1 = kTileGeom<1>;
 inline constexpr const TileGeom<2>& kGeom2 = kTileGeom<2>;
 
