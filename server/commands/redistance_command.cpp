@@ -33,6 +33,7 @@ int run_redistance(const RedistanceArgs& args) {
   stats.extra["band_half_width"] = result.band.half_width();
   stats.extra["interface_voxels"] = result.interface_voxels;
   stats.extra["sweep_iterations"] = result.sweep_iterations;
+  stats.extra["march_rounds"] = result.march_rounds;
   stats.extra["voxels_per_second"] = double(result.band.active_voxel_count()) / std::max(1e-12, secs(t1, t2));
   stats.extra["output"] = args.output;
   write_stats(stats, args.stats);

@@ -171,7 +171,11 @@ OperationResult run_redistance(const OperationContext& ctx) {
   o.progress = ctx.progress;
   RedistanceResult rr = redistance(*ctx.input, o);
   OperationResult r;
-  r.result = {{"method", method}, {"interface_voxels", rr.interface_voxels}, {"seconds", rr.seconds},
+  r.result = {{"method", method},
+              {"interface_voxels", rr.interface_voxels},
+              {"sweep_iterations", rr.sweep_iterations},
+              {"march_rounds", rr.march_rounds},
+              {"seconds", rr.seconds},
               {"active_voxels", rr.band.active_voxel_count()}};
   r.band = std::move(rr.band);
   return r;

@@ -75,10 +75,13 @@ pass
 for method in sweep march; do
   "$bin" redistance "$dir/box.lsg" --method "$method" --band 5 -o "$dir/r_$method.lsg" \
     --stats "$dir/r_$method.json" > /dev/null || fail "redistance $method"
-  "$py" - "$dir/r_$method.json" <<'PY' || fail "redistance stats"
+  "$py" - "$dir/r_$method.json" "$method" <<'PY' || fail "redistance stats"
 import json, sys
 s = json.load(open(sys.argv[1]))
 assert s["op"] == "redistance" and s["band_half_width"] == 5 and s["active_voxels"] > 0, s
+# The method's own count of passes over the bricks: iterations for the sweep, rounds for the march.
+counts = (s["sweep_iterations"], s["march_rounds"])
+assert (counts[0] >= 1 and counts[1] == 0) if sys.argv[2] == "sweep" else (counts[0] == 0 and counts[1] >= 1), s
 PY
   pass
 done
