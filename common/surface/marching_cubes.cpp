@@ -5,7 +5,9 @@
 #include <bit>
 #include <chrono>
 #include <cmath>
+#include <span>
 #include <string>
+#include <vector>
 
 #include <tbb/enumerable_thread_specific.h>
 
@@ -22,10 +24,17 @@ namespace {
 
 constexpr int kEdgeSlots = kBrickVoxels * 3;  // 1536; centroids follow
 
-struct BrickOut {
-  std::vector<Vec3d> vertices;   // owned edge vertices in slot order, then centroids
+// One brick's output: built in the thread's Scratch, kept in its OutputArena.
+struct BrickBuild {
+  std::vector<Vec3d> vertices;  // owned edge vertices in slot order, then centroids
   std::vector<Vec3f> normals;
   std::vector<std::array<VertexKey, 3>> triangles;
+  Neighborhood around{};
+};
+struct BrickOut {
+  std::span<const Vec3d> vertices;
+  std::span<const Vec3f> normals;
+  std::span<const std::array<VertexKey, 3>> triangles;
   Neighborhood around{};
   SlotBits<kEdgeSlots> owned;
   std::uint32_t edge_vertices = 0;
@@ -33,17 +42,25 @@ struct BrickOut {
   std::uint32_t extra = 0;
 };
 
-// Per-thread scratch: the tile and its edge crossings.
+// Per-thread scratch: the tile, its edge crossings, the brick being built and the arena that
+// keeps the built bricks.
 struct Scratch {
   CellTile tile;
   EdgeCrossings edges;
+  BrickBuild build;
+  OutputArena arena;
 };
 
 void process_brick(const NarrowBand& band, std::span<const float> decoded, std::uint32_t b, double iso,
-                   Scratch& scratch, BrickOut& out) {
+                   Scratch& scratch, BrickOut& kept) {
   CellTile& t = scratch.tile;
   const double h = band.voxel_size();
   ValidCells valid;
+  BrickBuild& out = scratch.build;
+  out.vertices.clear();
+  out.normals.clear();
+  out.triangles.clear();
+  BrickOut& counts = kept;  // owned slots, cells and extra vertices are recorded in place
   const Vec3d corner = begin_brick(band, b, iso, t, valid, out, decoded);
   out.triangles.reserve(2 * valid.mixed_cells + 8);
 
@@ -58,14 +75,14 @@ void process_brick(const NarrowBand& band, std::span<const float> decoded, std::
         const int p = CellTile::index(x, y, z);
         for (int a = 0; a < 3; ++a) {
           if (!((cr[a] >> (x + 1)) & 1u) || !valid.edge_used(x, y, z, a)) continue;
-          out.owned.set(3 * local_index(x, y, z) + a);
+          counts.owned.set(3 * local_index(x, y, z) + a);
           const double s = scratch.edges.at(p, a);
           out.vertices.push_back(corner + scratch.edges.point(x, y, z, a) * h);
           out.normals.push_back(normalized_f(corner_gradient(t, p) * (1.0 - s) + corner_gradient(t, p + kTileStride[a]) * s));
         }
       }
     }
-  out.edge_vertices = std::uint32_t(out.vertices.size());
+  counts.edge_vertices = std::uint32_t(out.vertices.size());
 
   // Cells.
   std::array<Vec3d, 12> pos;
@@ -80,7 +97,7 @@ void process_brick(const NarrowBand& band, std::span<const float> decoded, std::
         int m, d;
         cell::classify(a, m, d);
         if (m == 0 || m == 255) continue;
-        ++out.cells;
+        ++counts.cells;
         const cell::LoopSet& ls = cell::loops_for(m, d);
         for (int l = 0; l < ls.loop_count; ++l) {
           const int n = ls.length[l];
@@ -105,10 +122,10 @@ void process_brick(const NarrowBand& band, std::span<const float> decoded, std::
             Vec3d c{};
             for (int i = 0; i < n; ++i) c += pos[i];
             c = c / double(n);
-            const VertexKey ck = vertex_key(Neighborhood::slot(0, 0, 0), kEdgeSlots + int(out.extra));
+            const VertexKey ck = vertex_key(Neighborhood::slot(0, 0, 0), kEdgeSlots + int(counts.extra));
             out.vertices.push_back(corner + c * h);
             out.normals.push_back(normalized_f(gradient_at(t, c, x, y, z)));
-            ++out.extra;
+            ++counts.extra;
             for (int i = 0; i < n; ++i) out.triangles.push_back({ck, key[i], key[(i + 1) % n]});
             continue;
           }
@@ -117,6 +134,10 @@ void process_brick(const NarrowBand& band, std::span<const float> decoded, std::
             out.triangles.push_back({key[s], key[(s + i) % n], key[(s + i + 1) % n]});
         }
       }
+  kept.around = out.around;
+  kept.vertices = scratch.arena.keep(out.vertices);
+  kept.normals = scratch.arena.keep(out.normals);
+  kept.triangles = scratch.arena.keep(out.triangles);
 }
 
 }  // namespace

@@ -7,9 +7,13 @@
 #include <array>
 #include <bit>
 #include <cmath>
+#include <cstddef>
 #include <cstdint>
+#include <cstring>
 #include <functional>
 #include <limits>
+#include <new>
+#include <span>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -243,6 +247,48 @@ inline int best_fan_start(const Vec3d* p, int n) {
   }
   return best;
 }
+
+// Per-thread storage for the bricks' outputs until the merge: a brick's arrays, built in
+// reused scratch vectors, are copied into the thread's chunks (kChunkBytes each, huge pages
+// advised), so no brick allocates, and fresh memory is faulted in 2 MiB at a time (the
+// per-brick vectors were ~5 % of a warm extraction in malloc / free, and most of what a first
+// extraction in a fresh process pays more than a later one). Items keep their alignment.
+// Threading: one arena per thread. Not copyable; spans stay valid until it is destroyed.
+class OutputArena {
+ public:
+  static constexpr std::size_t kChunkBytes = std::size_t{4} << 20;
+  OutputArena() = default;
+  OutputArena(const OutputArena&) = delete;
+  OutputArena& operator=(const OutputArena&) = delete;
+  ~OutputArena() {
+    for (std::byte* c : chunks_) ::operator delete[](c, std::align_val_t(kAlign));
+  }
+  template <typename T>
+  std::span<const T> keep(const std::vector<T>& items) {
+    if (items.empty()) return {};
+    const std::size_t bytes = items.size() * sizeof(T);
+    std::byte* at = allocate(bytes, alignof(T));
+    std::memcpy(at, items.data(), bytes);
+    return {reinterpret_cast<const T*>(at), items.size()};
+  }
+
+ private:
+  static constexpr std::size_t kAlign = std::size_t{2} << 20;
+  std::byte* allocate(std::size_t bytes, std::size_t align) {
+    used_ = (used_ + align - 1) & ~(align - 1);
+    if (chunks_.empty() || used_ + bytes > size_) {
+      size_ = std::max(kChunkBytes, (bytes + kAlign - 1) & ~(kAlign - 1));
+      chunks_.push_back(static_cast<std::byte*>(::operator new[](size_, std::align_val_t(kAlign))));
+      advise_huge_pages(chunks_.back(), size_);
+      used_ = 0;
+    }
+    std::byte* at = chunks_.back() + used_;
+    used_ += bytes;
+    return at;
+  }
+  std::vector<std::byte*> chunks_;
+  std::size_t size_ = 0, used_ = 0;
+};
 
 void check_iso(const NarrowBand& band, double iso, std::string_view where);
 
