@@ -6,6 +6,8 @@
 #include <chrono>
 #include <cmath>
 #include <optional>
+#include <span>
+#include <vector>
 
 #include <tbb/enumerable_thread_specific.h>
 
@@ -25,14 +27,23 @@ namespace {
 constexpr int kLoopSlots = kBrickVoxels * 4;  // 2048
 constexpr int kSplitSlot0 = kLoopSlots;
 
-struct BrickOut {
+// One brick's output: built in the thread's Scratch, kept in its OutputArena.
+struct BrickBuild {
   std::vector<Vec3d> vertices;  // loop vertices in slot order, then split-loop vertices in slot order
   std::vector<Vec3f> normals;
   std::vector<std::array<VertexKey, 3>> triangles;
   std::vector<std::array<VertexKey, 4>> quads;
+  std::vector<std::uint16_t> split_slots;  // sorted, slot - kSplitSlot0
+  Neighborhood around{};
+};
+struct BrickOut {
+  std::span<const Vec3d> vertices;
+  std::span<const Vec3f> normals;
+  std::span<const std::array<VertexKey, 3>> triangles;
+  std::span<const std::array<VertexKey, 4>> quads;
   Neighborhood around{};
   SlotBits<kLoopSlots> owned;
-  std::vector<std::uint16_t> split_slots;  // sorted, slot - kSplitSlot0
+  std::span<const std::uint16_t> split_slots;
   std::uint32_t loop_vertices = 0;
   std::uint64_t cells = 0;
 };
@@ -190,13 +201,21 @@ struct Scratch {
     Vec3f normal;
   };
   std::vector<SplitVertex> split_vertices;
+  BrickBuild build;
+  OutputArena arena;
 };
 
-void process_brick(const NarrowBand& band, std::uint32_t b, double iso, int iterations,
-                   Scratch& s, BrickOut& out) {
+// Builds brick b's output in s.build (its counts and owned slots straight into `kept`).
+void build_brick(const NarrowBand& band, std::uint32_t b, double iso, int iterations, Scratch& s, BrickOut& kept) {
   CellTile& t = s.tile;
   const double h = band.voxel_size();
   ValidCells valid;
+  BrickBuild& out = s.build;
+  out.vertices.clear();
+  out.normals.clear();
+  out.triangles.clear();
+  out.quads.clear();
+  out.split_slots.clear();
   const Vec3d corner = begin_brick(band, b, iso, t, valid, out);
   const Coord base = brick_origin(band.bricks()[b].coord);
   out.quads.reserve(valid.mixed_cells + 8);
@@ -221,7 +240,7 @@ void process_brick(const NarrowBand& band, std::uint32_t b, double iso, int iter
         s.split[ci] = ls.doubled_face_loops ? split_loops(band, base, t, valid, x, y, z, ls, iso) : 0;
         any_split |= s.split[ci] != 0;
         if (ls.loop_count == 0 || x < 0 || y < 0 || z < 0) continue;
-        ++out.cells;
+        ++kept.cells;
         const int p0 = CellTile::index(x, y, z);
         const CellField cf(s.field, p0);
         const int li = local_index(x, y, z);
@@ -229,7 +248,7 @@ void process_brick(const NarrowBand& band, std::uint32_t b, double iso, int iter
           const Vec3d centre = loop_centroid(s.edges, p0, ls, l);
           if (!((s.split[ci] >> l) & 1)) {
             const Vec3d c = cf.project(centre, iterations);
-            out.owned.set(4 * li + l);
+            kept.owned.set(4 * li + l);
             out.vertices.push_back(world(x, y, z, c));
             out.normals.push_back(cf.normal(c));
             continue;
@@ -252,7 +271,7 @@ void process_brick(const NarrowBand& band, std::uint32_t b, double iso, int iter
             out.triangles.push_back({key[std::size_t(f)], key[std::size_t((f + i) % n)], key[std::size_t((f + i + 1) % n)]});
         }
       }
-  out.loop_vertices = std::uint32_t(out.vertices.size());
+  kept.loop_vertices = std::uint32_t(out.vertices.size());
   std::sort(s.split_vertices.begin(), s.split_vertices.end(),
             [](const Scratch::SplitVertex& a, const Scratch::SplitVertex& b) { return a.slot < b.slot; });
   for (const Scratch::SplitVertex& v : s.split_vertices) {
@@ -333,6 +352,17 @@ void process_brick(const NarrowBand& band, std::uint32_t b, double iso, int iter
           }
         }
       }
+}
+
+void process_brick(const NarrowBand& band, std::uint32_t b, double iso, int iterations, Scratch& s, BrickOut& kept) {
+  build_brick(band, b, iso, iterations, s, kept);
+  const BrickBuild& out = s.build;
+  kept.around = out.around;
+  kept.vertices = s.arena.keep(out.vertices);
+  kept.normals = s.arena.keep(out.normals);
+  kept.triangles = s.arena.keep(out.triangles);
+  kept.quads = s.arena.keep(out.quads);
+  kept.split_slots = s.arena.keep(out.split_slots);
 }
 
 }  // namespace
