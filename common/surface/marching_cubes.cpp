@@ -52,7 +52,7 @@ struct Scratch {
 };
 
 void process_brick(const NarrowBand& band, std::span<const float> decoded, std::uint32_t b, double iso,
-                   Scratch& scratch, BrickOut& kept) {
+                   Scratch& scratch, BrickOut& kept) {  // owned slots and counts go straight into kept
   CellTile& t = scratch.tile;
   const double h = band.voxel_size();
   ValidCells valid;
@@ -60,7 +60,6 @@ void process_brick(const NarrowBand& band, std::span<const float> decoded, std::
   out.vertices.clear();
   out.normals.clear();
   out.triangles.clear();
-  BrickOut& counts = kept;  // owned slots, cells and extra vertices are recorded in place
   const Vec3d corner = begin_brick(band, b, iso, t, valid, out, decoded);
   out.triangles.reserve(2 * valid.mixed_cells + 8);
 
@@ -75,14 +74,14 @@ void process_brick(const NarrowBand& band, std::span<const float> decoded, std::
         const int p = CellTile::index(x, y, z);
         for (int a = 0; a < 3; ++a) {
           if (!((cr[a] >> (x + 1)) & 1u) || !valid.edge_used(x, y, z, a)) continue;
-          counts.owned.set(3 * local_index(x, y, z) + a);
+          kept.owned.set(3 * local_index(x, y, z) + a);
           const double s = scratch.edges.at(p, a);
           out.vertices.push_back(corner + scratch.edges.point(x, y, z, a) * h);
           out.normals.push_back(normalized_f(corner_gradient(t, p) * (1.0 - s) + corner_gradient(t, p + kTileStride[a]) * s));
         }
       }
     }
-  counts.edge_vertices = std::uint32_t(out.vertices.size());
+  kept.edge_vertices = std::uint32_t(out.vertices.size());
 
   // Cells.
   std::array<Vec3d, 12> pos;
@@ -97,7 +96,7 @@ void process_brick(const NarrowBand& band, std::span<const float> decoded, std::
         int m, d;
         cell::classify(a, m, d);
         if (m == 0 || m == 255) continue;
-        ++counts.cells;
+        ++kept.cells;
         const cell::LoopSet& ls = cell::loops_for(m, d);
         for (int l = 0; l < ls.loop_count; ++l) {
           const int n = ls.length[l];
@@ -122,10 +121,10 @@ void process_brick(const NarrowBand& band, std::span<const float> decoded, std::
             Vec3d c{};
             for (int i = 0; i < n; ++i) c += pos[i];
             c = c / double(n);
-            const VertexKey ck = vertex_key(Neighborhood::slot(0, 0, 0), kEdgeSlots + int(counts.extra));
+            const VertexKey ck = vertex_key(Neighborhood::slot(0, 0, 0), kEdgeSlots + int(kept.extra));
             out.vertices.push_back(corner + c * h);
             out.normals.push_back(normalized_f(gradient_at(t, c, x, y, z)));
-            ++counts.extra;
+            ++kept.extra;
             for (int i = 0; i < n; ++i) out.triangles.push_back({ck, key[i], key[(i + 1) % n]});
             continue;
           }
