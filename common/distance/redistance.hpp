@@ -57,7 +57,7 @@
 //   0.010); torus R=192: 0.003 h, 0.0015; knot R=256: 0.008 h, 0.006.
 // Cost: Sweep O(domain voxels) per iteration, typically 3-4 iterations (each voxel is
 //   evaluated ~6 times); March O(n log n) per brick march of n voxels, typically 3-4 rounds
-//   with each brick marching ~1.7 times (knot R=512, W=3). Growing the band adds
+//   with each brick marching about twice (knot R=512, W=3). Growing the band adds
 //   O(ceil(W - W_in) * bricks). Memory: 4 bytes per voxel of the domain's bricks plus masks,
 //   besides the input and the output.
 // Threading: TBB. Interface set-up, sweeping or marching (per brick, in two checkerboard
