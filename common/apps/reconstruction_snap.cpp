@@ -367,7 +367,8 @@ SnapOutput snap_level(NarrowBand band, const PointIndex& index, const Reconstruc
     settings.height_neighbors = std::max(o.neighbors, kHeightNeighbors);
     if (previous_noise >= kCleanNoise) {
       settings.noisy_height = true;
-      settings.height_neighbors = std::max(settings.height_neighbors, noisy_height_neighbors(band, index.size(), h_final, previous_height_noise));
+      settings.height_neighbors =
+          std::max(settings.height_neighbors, noisy_height_neighbors(band, index.size(), h_final, previous_height_noise));
     } else if (previous_height_noise > 0.0) {  // clean so far: more points as the noise grows
       settings.height_neighbors = std::max(settings.height_neighbors,
                                            height_neighbors_for(front_density(band, index.size(), h_final),
