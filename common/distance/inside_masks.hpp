@@ -26,15 +26,15 @@
 //     meshes: path independent, up to the tree's error in w_ref (~1e-2, far below 1/2).
 //   - Bricks within two bricks of an open edge (open_edges.hpp: holes, borders, inconsistent
 //     or non-orientable regions, unmatched fins), where w also varies continuously: adaptive
-//     octree refinement with a trilinear model of the continuous part, checked by direct
-//     queries, down to direct queries next to open edges (inside_adaptive).
+//     octree refinement with a trilinear model of the continuous part, the nearby open edges'
+//     part exact (their cones), checked by direct queries (inside_adaptive).
 // Points exactly on the surface: classified like the point displaced infinitesimally towards
 //   -x, then -y, then -z (grid_crossings.hpp); e.g. the voxels of an axis-aligned box
 //   [x0, x1] x [y0, y1] x [z0, z1] (grid units) that are inside are x0 < i <= x1,
 //   y0 < j <= y1, z0 < k <= z1.
 // Cost: per brick ~ triangles x (grid lines under their projections) 2D tests; closed meshes
 //   add three face-edge tests per brick and O(F) box tests per group of bricks (no tree),
-//   others one tree query per brick (9 to ~500 near open edges) and the tree's build,
+//   others one tree query per brick (9 to ~60 near open edges) and the tree's build,
 //   O(F log F); O(F log F) once for the open edges; memory O(F) for a grid-space copy of the
 //   triangles. Measured before the closed path (one core, g++ -O3): CGAL bunny00.off (75k
 //   triangles) at 512^3, margin 3h, 20280 bricks: 0.25 s; knot.off at 512^3: 0.17 s. The
