@@ -184,35 +184,21 @@ struct Adaptive {
     return false;
   }
 
-  // The inside bits of the block from its modelled values. Voxels exactly on the surface, as on
-  // the direct path: an off-surface neighbour's value plus the exact jump (on a flat sheet the
-  // model would sit at 1/2 itself). `checked`: voxels modelled within kAmbiguousBand of 1/2 are
-  // queried directly.
+  // The inside bits of the block from its modelled values. Voxels exactly on the surface get a
+  // direct off-surface neighbour's value plus the exact jump, as on the direct path (a flat
+  // sheet's model sits at 1/2 there, and a modelled neighbour may itself lie on the surface
+  // unflagged, where the model follows no side). `checked`: voxels modelled within
+  // kAmbiguousBand of 1/2 are queried directly.
   void write_inside(const Coord& lo, int s, const double* modelled, bool checked) {
-    auto in_block = [&](const Coord& m) {
-      return m.x >= lo.x && m.x < lo.x + s && m.y >= lo.y && m.y < lo.y + s && m.z >= lo.z &&
-             m.z < lo.z + s;
-    };
     for (int k = lo.z; k < lo.z + s; ++k)
       for (int j = lo.y; j < lo.y + s; ++j)
         for (int i = lo.x; i < lo.x + s; ++i) {
           const int n = local_index(i, j, k);
           double w = modelled[n];
-          if (x.on_surface.test(n)) {
-            bool found = false;
-            for (int a = 0; a < 3 && !found; ++a)
-              for (int step : {-1, 1}) {
-                Coord m{i, j, k};
-                m[a] += step;
-                if (!in_block(m) || x.on_surface.test(local_index(m.x, m.y, m.z))) continue;
-                w = modelled[local_index(m.x, m.y, m.z)] + jump(x, m, a, -step);
-                found = true;
-                break;
-              }
-            if (!found) w = surface_value(n);  // no off-surface neighbour in the block
-          } else if (checked && std::abs(w - 0.5) < kAmbiguousBand) {
+          if (x.on_surface.test(n))
+            w = surface_value(n);
+          else if (checked && std::abs(w - 0.5) < kAmbiguousBand)
             w = direct(n);
-          }
           inside.assign(n, w > 0.5);
         }
   }
@@ -228,12 +214,32 @@ struct Adaptive {
                          lo.z + ((bits & 4) ? s - 1 : 0));
     };
     auto known_at = [&](int n) { return known_part ? known_part[n] : 0.0; };
+    auto in_block = [&](const Coord& m) {
+      return m.x >= lo.x && m.x < lo.x + s && m.y >= lo.y && m.y < lo.y + s && m.z >= lo.z &&
+             m.z < lo.z + s;
+    };
+    // w - known at voxel n. On the surface, with a known part: an off-surface neighbour in the
+    // block plus the exact jump of w - known, which has no singularity there (w itself may
+    // change by much more than its jump over one voxel near a rim).
+    auto remainder = [&](int n) {
+      if (known_part && x.on_surface.test(n)) {
+        const Coord c = local_coord(n);
+        for (int a = 0; a < 3; ++a)
+          for (int step : {-1, 1}) {
+            Coord m = c;
+            m[a] += step;
+            const int k = local_index(m.x, m.y, m.z);
+            if (in_block(m) && !x.on_surface.test(k))
+              return direct(k) - known_part[k] + jump(jumps, m, a, -step);
+          }
+      }
+      return value_of(n) - known_at(n);
+    };
     if (ref < 0 || jumps.on_surface.test(ref)) ref = corner(0);
     propagate(jumps, local_coord(ref), lo, s, rel);
-    const double wr = value_of(ref) - known_at(ref);
+    const double wr = remainder(ref);
     double smooth[8];
-    for (int b = 0; b < 8; ++b)
-      smooth[b] = value_of(corner(b)) - known_at(corner(b)) - (wr + rel[corner(b)]);
+    for (int b = 0; b < 8; ++b) smooth[b] = remainder(corner(b)) - (wr + rel[corner(b)]);
     auto model = [&](int i, int j, int k) {
       const double tx = double(i - lo.x) / (s - 1), ty = double(j - lo.y) / (s - 1),
                    tz = double(k - lo.z) / (s - 1);
@@ -245,8 +251,9 @@ struct Adaptive {
       return wr + rel[n] + m + known_at(n);
     };
     const int c = s / 2;
-    if (std::abs(value_of(local_index(lo.x + c, lo.y + c, lo.z + c)) -
-                 model(lo.x + c, lo.y + c, lo.z + c)) > kAdaptiveTolerance)
+    const int centre = local_index(lo.x + c, lo.y + c, lo.z + c);
+    if (std::abs(remainder(centre) + known_at(centre) - model(lo.x + c, lo.y + c, lo.z + c)) >
+        kAdaptiveTolerance)
       return false;
     double modelled[kBrickVoxels];
     for (int k = lo.z; k < lo.z + s; ++k)

@@ -84,16 +84,23 @@ OpenEdgeInfo find_open_edges(const TriangleMesh& mesh, std::span<const Vec3d> gr
   return info;
 }
 
-// The open edges of the triangles listed by a brick and its 26 neighbours (every open edge
-// within the brick's width of it, given a margin >= 0), in brick-local grid coordinates.
+// The open edges that meet the brick's voxel-centre box grown by kRimReach voxels (all that
+// inside_adaptive reads: its 8^3 block looks half its size around), in brick-local grid
+// coordinates. Taken from the brick's own list where its margin covers that box (the lists
+// hold every triangle within the margin, Euclidean, of the box), else from its 26 neighbours'
+// too.
+constexpr double kRimReach = 0.5 * kBrickDim;
+
 void gather_rims(const BrickTriangleLists& lists, std::size_t i, std::span<const GridTriangle> grid,
-                 const OpenEdgeInfo& info, std::vector<std::uint64_t>& scratch,
+                 const OpenEdgeInfo& info, double voxel_size, std::vector<std::uint64_t>& scratch,
                  std::vector<OpenSegment>& rims) {
   rims.clear();
   scratch.clear();
-  for (int dz = -1; dz <= 1; ++dz)
-    for (int dy = -1; dy <= 1; ++dy)
-      for (int dx = -1; dx <= 1; ++dx) {
+  const bool own_list_covers = lists.margin >= kRimReach * std::sqrt(3.0) * voxel_size * (1 + 1e-9);
+  const int reach = own_list_covers ? 0 : 1;
+  for (int dz = -reach; dz <= reach; ++dz)
+    for (int dy = -reach; dy <= reach; ++dy)
+      for (int dx = -reach; dx <= reach; ++dx) {
         const std::size_t j = find_brick(lists, lists.bricks[i] + Coord{dx, dy, dz});
         if (j == lists.bricks.size()) continue;
         for (std::uint64_t k = lists.offsets[j]; k < lists.offsets[j + 1]; ++k) {
@@ -103,14 +110,19 @@ void gather_rims(const BrickTriangleLists& lists, std::size_t i, std::span<const
               scratch.push_back(std::uint64_t(t) * 4 + std::uint64_t(e));
         }
       }
-  std::sort(scratch.begin(), scratch.end());
-  scratch.erase(std::unique(scratch.begin(), scratch.end()), scratch.end());
+  if (reach > 0) {  // a triangle may be listed by several of the 27 bricks
+    std::sort(scratch.begin(), scratch.end());
+    scratch.erase(std::unique(scratch.begin(), scratch.end()), scratch.end());
+  }
   const Coord o = brick_origin(lists.bricks[i]);
   const Vec3d origin{double(o.x), double(o.y), double(o.z)};
+  const Vec3d lo{-kRimReach, -kRimReach, -kRimReach};
+  const Vec3d hi = Vec3d{1, 1, 1} * (kBrickDim - 1 + kRimReach);
   for (std::uint64_t code : scratch) {
     const GridTriangle& g = grid[code / 4];
     const int e = int(code % 4);
-    rims.push_back({g.corner[e] - origin, g.corner[(e + 1) % 3] - origin});
+    const OpenSegment segment{g.corner[e] - origin, g.corner[(e + 1) % 3] - origin};
+    if (segment_meets_box(segment[0], segment[1], lo, hi)) rims.push_back(segment);
   }
 }
 
@@ -319,7 +331,7 @@ InsideMasksResult compute_inside_masks(const TriangleMesh& oriented_mesh,
             if (unsafe[i]) {
               crossings = BrickCrossings{};
               brick_crossings(grid, ids, lists.bricks[i], kAllLines, crossings);
-              gather_rims(lists, i, grid, open, scratch, rims);
+              gather_rims(lists, i, grid, open, frame.voxel_size, scratch, rims);
               result.inside[i] =
                   inside_adaptive(crossings, lists.bricks[i], rims, context, queries[i]);
             } else {
