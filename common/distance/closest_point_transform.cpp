@@ -278,7 +278,6 @@ CptResult closest_point_transform(const TriangleMesh& mesh, const CptOptions& op
   // Unsigned distances and closest triangles.
   t = Clock::now();
   ClosestTriangleField field;
-  bool maybe_open = true;  // edges with an odd number of faces: open, the sign needs the margin
   if (slab) {
     field = slab_scan(mesh, lists, options.frame, options.frame.half_width, options.progress);
   } else {
@@ -289,7 +288,6 @@ CptResult closest_point_transform(const TriangleMesh& mesh, const CptOptions& op
     field = std::move(scanned.field);
     result.polyhedra = scanned.polyhedra;
     result.evaluations = scanned.evaluations;
-    maybe_open = scanned.odd_edges > 0;
   }
   result.seconds.distance = since(t);
   options.progress.step(0.7, "distance");
@@ -306,22 +304,12 @@ CptResult closest_point_transform(const TriangleMesh& mesh, const CptOptions& op
   InsideMasksOptions sign_options;
   sign_options.frame = options.frame;
   sign_options.progress = options.progress;
-  // Near open edges w also varies continuously, and the masks find the bricks that need direct
-  // queries through the triangles listed within the band's margin: open meshes get lists with
-  // it, as the slab scan's, so they get the same signs (and membranes) either way. A mesh
-  // whose edges all have an even number of faces may still be open for the sign (inconsistent
-  // orientation): then the masks run again with those lists.
-  auto wide_lists = [&] {
-    bin.margin = options.frame.half_width * options.frame.voxel_size;
-    return bin_triangles_to_bricks(mesh, bin);
-  };
-  BrickTriangleLists sign_lists =
-      slab ? std::move(lists) : (maybe_open ? wide_lists() : band_brick_lists(field, lists));
+  // The band's bricks with their triangles. The masks need every triangle meeting a brick
+  // listed (margin >= h/2 for the closed path); near open edges they read the bricks'
+  // neighbours, which the band holds (a rim lies on the mesh). Beyond that their result does
+  // not depend on the lists' margin, so both scans give the same signs and membranes.
+  BrickTriangleLists sign_lists = band_brick_lists(field, lists);
   InsideMasksResult signs = compute_inside_masks(oriented.mesh, tree, sign_lists, sign_options);
-  if (signs.open_edges > 0 && !slab && !maybe_open) {
-    sign_lists = wide_lists();
-    signs = compute_inside_masks(oriented.mesh, tree, sign_lists, sign_options);
-  }
   result.winding_queries = signs.winding_queries;
   result.ray_queries = signs.ray_queries;
   result.open_edges = signs.open_edges;

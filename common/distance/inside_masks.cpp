@@ -32,9 +32,9 @@ std::size_t find_brick(const BrickTriangleLists& lists, const Coord& b) {
                                                            : nb;
 }
 
-// Open edges (open_edges.hpp) per triangle, and the bricks near them: those listing a triangle
-// with an open edge, and the listed bricks within kOpenReach bricks of those (reach >= 16
-// voxels; beyond it the continuous part of w changes by well under 1/2 across a brick).
+// Open edges (open_edges.hpp) per triangle, and the bricks near them: those with an open edge
+// within a voxel, and the listed bricks within kOpenReach bricks of those (reach >= 16 voxels;
+// beyond it the continuous part of w changes by well under 1/2 across a brick).
 constexpr int kOpenReach = 2;
 
 struct OpenEdgeInfo {
@@ -70,9 +70,18 @@ OpenEdgeInfo find_open_edges(const TriangleMesh& mesh, std::span<const Vec3d> gr
     }
   });
   for (std::size_t i = 0; i < nb; ++i) {
+    // An open edge meeting the brick's voxel-centre box grown by one voxel (not just a listed
+    // triangle with one: the masks then do not depend on the lists' margin, given >= h).
+    const Coord o = brick_origin(lists.bricks[i]);
+    const Vec3d lo = Vec3d{double(o.x), double(o.y), double(o.z)} - Vec3d{1, 1, 1};
+    const Vec3d hi = lo + Vec3d{1, 1, 1} * double(kBrickDim + 1);
     bool core = false;
-    for (std::uint64_t k = lists.offsets[i]; k < lists.offsets[i + 1] && !core; ++k)
-      core = info.triangle_edges[lists.triangles[k]] != 0;
+    for (std::uint64_t k = lists.offsets[i]; k < lists.offsets[i + 1] && !core; ++k) {
+      const std::uint32_t t = lists.triangles[k];
+      for (int e = 0; e < 3 && !core; ++e)
+        core = ((info.triangle_edges[t] >> e) & 1u) &&
+               segment_meets_box(grid[t].corner[e], grid[t].corner[(e + 1) % 3], lo, hi);
+    }
     if (!core) continue;
     for (int dz = -kOpenReach; dz <= kOpenReach; ++dz)
       for (int dy = -kOpenReach; dy <= kOpenReach; ++dy)
