@@ -28,7 +28,8 @@
 //   consistently (orient_faces), then every voxel of every brick gets the generalized winding
 //   number test (> 1/2 is inside) from signed crossings along grid edges plus, for closed
 //   meshes, one exact ray per connected group of bricks, otherwise one hierarchical
-//   evaluation per brick (compute_inside_masks) — robust for holes, open boundaries,
+//   evaluation per brick, more near open edges, whose nearby segments' cones carry the
+//   continuous part (compute_inside_masks, brick_winding.hpp) — robust for holes, open boundaries,
 //   self-intersections and flipped faces (thesis open issue 5.3). Then, for open meshes only,
 //   the membranes (membrane_band.hpp).
 // Cost: characteristic: O(band voxels + triangles * columns per polyhedron); slab scan:
