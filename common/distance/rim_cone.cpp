@@ -121,32 +121,6 @@ double cone_winding(const RimCone& cone, const Vec3d& p) {
   return omega / (4.0 * std::numbers::pi);
 }
 
-namespace {
-
-// atan2(y, x) without branches (selects only, so that loops over it vectorise): the octant
-// reduction to t = min / max in [0, 1], then t > tan(pi / 8) shifted by pi / 4 to
-// |u| <= tan(pi / 8), where the Taylor series to u^15 is within 2e-8. 0 for y == 0, as
-// triangle_solid_angle's exact 0 in the triangle's plane.
-inline double polynomial_atan2(double y, double x) {
-  constexpr double kTanPi8 = 0.41421356237309503;
-  constexpr double kPi = std::numbers::pi;
-  const double ay = std::abs(y), ax = std::abs(x);
-  const double hi = std::max(ax, ay), lo = std::min(ax, ay);
-  const double t = hi > 0.0 ? lo / hi : 0.0;
-  const bool shifted = t > kTanPi8;
-  const double u = shifted ? (t - 1.0) / (t + 1.0) : t;
-  const double u2 = u * u;
-  const double series =
-      u * (1.0 + u2 * (-1.0 / 3 + u2 * (1.0 / 5 + u2 * (-1.0 / 7 + u2 * (1.0 / 9 + u2 * (-1.0 / 11 +
-           u2 * (1.0 / 13 + u2 * (-1.0 / 15))))))));
-  double r = (shifted ? 0.25 * kPi : 0.0) + series;
-  r = ay > ax ? 0.5 * kPi - r : r;
-  r = x < 0.0 ? kPi - r : r;
-  r = y < 0.0 ? -r : r;
-  return y == 0.0 ? 0.0 : r;
-}
-
-}  // namespace
 
 #if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__)
 __attribute__((target_clones("avx512f", "avx2", "default")))

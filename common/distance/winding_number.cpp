@@ -247,7 +247,7 @@ double winding_number(const WindingNumberTree& tree, const Vec3d& p, double beta
     } else if (node.leaf) {
       for (std::uint32_t i = node.left; i < node.right; ++i) {
         const auto& t = tree.corners[i];
-        omega += triangle_solid_angle(p, t[0], t[1], t[2]);
+        omega += fast_triangle_solid_angle(p, t[0], t[1], t[2]);
       }
     } else {
       stack[top++] = node.right;

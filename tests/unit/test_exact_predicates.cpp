@@ -153,5 +153,35 @@ TEST(SolidAngle, SignAndOctantAndPlane) {
               1e-6);
 }
 
+TEST(SolidAngle, PolynomialArctangentFollowsTheLibraryOne) {
+  std::mt19937_64 rng(3);
+  std::uniform_real_distribution<double> angle(-std::numbers::pi, std::numbers::pi);
+  std::uniform_real_distribution<double> scale(-30.0, 30.0);
+  double worst = 0.0;
+  for (int i = 0; i < 200000; ++i) {
+    const double a = angle(rng), r = std::exp2(scale(rng));
+    const double y = r * std::sin(a), x = r * std::cos(a);
+    worst = std::max(worst, std::abs(polynomial_atan2(y, x) - std::atan2(y, x)));
+  }
+  EXPECT_LT(worst, 2e-8);
+  // Axes and the branch cut: atan2's values, and 0 on the x axis (either side).
+  EXPECT_NEAR(polynomial_atan2(1.0, 0.0), std::numbers::pi / 2, 2e-8);
+  EXPECT_NEAR(polynomial_atan2(-1.0, 0.0), -std::numbers::pi / 2, 2e-8);
+  EXPECT_NEAR(polynomial_atan2(1e-300, -1.0), std::numbers::pi, 2e-8);
+  EXPECT_NEAR(polynomial_atan2(-1e-300, -1.0), -std::numbers::pi, 2e-8);
+  EXPECT_EQ(polynomial_atan2(0.0, -1.0), 0.0);
+  EXPECT_EQ(polynomial_atan2(0.0, 0.0), 0.0);
+  // The fast solid angle against the exact one, from random points.
+  std::uniform_real_distribution<double> U(-2.0, 2.0);
+  const Vec3d a{0.1, -0.2, 0.3}, b{1.1, 0.4, -0.2}, c{-0.3, 0.9, 0.5};
+  double worst_angle = 0.0;
+  for (int i = 0; i < 20000; ++i) {
+    const Vec3d q{U(rng), U(rng), U(rng)};
+    worst_angle = std::max(worst_angle, std::abs(fast_triangle_solid_angle(q, a, b, c) -
+                                                 triangle_solid_angle(q, a, b, c)));
+  }
+  EXPECT_LT(worst_angle, 4e-8);
+}
+
 }  // namespace
 }  // namespace levelset
