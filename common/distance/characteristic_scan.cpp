@@ -548,6 +548,16 @@ void scan_triangle_features(const TriangleMesh& mesh, const Adjacency& adj, std:
       cover = std::max(cover, reach + 2 * scanner.slack());
     }
     scan_prism(tf, t, cover, scanner);
+  } else {
+    // A degenerate face whose vertices lie within 1e-6 h of its longest edge's line: that
+    // edge's cylinder holds its closest points to within that (the shorter edges are on it).
+    // Subdivided degenerate faces (CGAL's degtri_sliding.off) scanned all three cylinders.
+    int longest = 0;
+    for (int k = 1; k < 3; ++k)
+      if (length(tf.v[(k + 1) % 3] - tf.v[k]) > length(tf.v[(longest + 1) % 3] - tf.v[longest])) longest = k;
+    const double twice_area = length(cross(tf.v[1] - tf.v[0], tf.v[2] - tf.v[0]));
+    if (tf.scale > 0 && twice_area / tf.scale <= 1e-6 * scanner.voxel_size())
+      for (int k = 0; k < 3; ++k) covered[k] = k != longest;
   }
   for (int k = 0; k < 3; ++k)
     if (!covered[k]) scan_wedge(tf, t, k, wedges[k], scanner);
