@@ -119,21 +119,23 @@ std::vector<Vec3d> to_grid_vertices(const TriangleMesh& mesh, const GridFrame& f
   return g;
 }
 
+GridTriangle make_grid_triangle(const Vec3d& a, const Vec3d& b, const Vec3d& c) {
+  GridTriangle t;
+  t.corner = {a, b, c};
+  for (int w = 0; w < 3; ++w) {
+    const int u = (w + 1) % 3, v = (w + 2) % 3;
+    t.normal_sign[w] = std::int8_t(orient2d_sign(a[u], a[v], b[u], b[v], c[u], c[v]));
+  }
+  return t;
+}
+
 std::vector<GridTriangle> to_grid_triangles(const TriangleMesh& mesh, std::span<const Vec3d> g) {
   const std::size_t nt = mesh.triangles.size();
   std::vector<GridTriangle> out(nt);
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, nt, 1024), [&](const auto& r) {
     for (std::size_t t = r.begin(); t != r.end(); ++t) {
       const auto& f = mesh.triangles[t];
-      GridTriangle& gt = out[t];
-      gt.corner = {g[f[0]], g[f[1]], g[f[2]]};
-      const Vec3d& a = gt.corner[0];
-      const Vec3d& b = gt.corner[1];
-      const Vec3d& c = gt.corner[2];
-      for (int w = 0; w < 3; ++w) {
-        const int u = (w + 1) % 3, v = (w + 2) % 3;
-        gt.normal_sign[w] = std::int8_t(orient2d_sign(a[u], a[v], b[u], b[v], c[u], c[v]));
-      }
+      out[t] = make_grid_triangle(g[f[0]], g[f[1]], g[f[2]]);
     }
   });
   return out;

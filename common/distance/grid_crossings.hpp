@@ -52,8 +52,9 @@ struct GridTriangle {
 };
 
 // Grid-space vertices (v - origin) / h, and grid-space copies of all triangles with the exact
-// signs of their normals (TBB parallel; indices must be valid).
+// signs of their normals (TBB parallel; indices must be valid); make_grid_triangle: one.
 std::vector<Vec3d> to_grid_vertices(const TriangleMesh& mesh, const GridFrame& frame);
+GridTriangle make_grid_triangle(const Vec3d& a, const Vec3d& b, const Vec3d& c);
 std::vector<GridTriangle> to_grid_triangles(const TriangleMesh& mesh,
                                             std::span<const Vec3d> grid_vertices);
 

@@ -5,7 +5,6 @@
 #include <numbers>
 #include <utility>
 
-#include "distance/exact_predicates.hpp"
 #include "distance/solid_angle.hpp"
 #include "grid/coord.hpp"
 
@@ -166,18 +165,7 @@ std::vector<GridTriangle> reversed_cone_triangles(const RimCone& cone, const Coo
   std::vector<GridTriangle> out;
   out.reserve(cone.segments.size());
   const Vec3d apex = cone.apex + o;
-  for (const OpenSegment& e : cone.segments) {
-    GridTriangle t;
-    t.corner = {e[1] + o, e[0] + o, apex};
-    const Vec3d& a = t.corner[0];
-    const Vec3d& b = t.corner[1];
-    const Vec3d& c = t.corner[2];
-    for (int w = 0; w < 3; ++w) {
-      const int u = (w + 1) % 3, v = (w + 2) % 3;
-      t.normal_sign[w] = std::int8_t(orient2d_sign(a[u], a[v], b[u], b[v], c[u], c[v]));
-    }
-    out.push_back(t);
-  }
+  for (const OpenSegment& e : cone.segments) out.push_back(make_grid_triangle(e[1] + o, e[0] + o, apex));
   return out;
 }
 
