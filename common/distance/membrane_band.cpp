@@ -353,11 +353,19 @@ class Membranes {
         if (k >= input_count_) {
           std::copy(far_w_[k - input_count_].begin(), far_w_[k - input_count_].end(), wd);
         } else {
+          // One traversal for the brick's membrane voxels (winding_numbers).
           const Coord o = brick_origin(c);
+          std::array<Vec3d, kBrickVoxels> points;
+          std::array<double, kBrickVoxels> values;
+          std::size_t count = 0;
           membrane_[k].for_each_set([&](int n) {
-            wd[n] = float(query_w(tree_, o_.frame, o + local_coord(n), o_.beta));
-            ++queries[d];
+            const Coord g = o + local_coord(n);
+            points[count++] = o_.frame.origin + Vec3d{double(g.x), double(g.y), double(g.z)} * o_.frame.voxel_size;
           });
+          winding_numbers(tree_, std::span(points.data(), count), o_.beta, std::span(values.data(), count));
+          count = 0;
+          membrane_[k].for_each_set([&](int n) { wd[n] = float(values[count++]); });
+          queries[d] += count;
         }
       }
     });

@@ -257,6 +257,46 @@ double winding_number(const WindingNumberTree& tree, const Vec3d& p, double beta
   return omega / (4.0 * std::numbers::pi);
 }
 
+namespace {
+
+// Points idx[b, e) have reached node `at`: those far from it take its expansion, the rest go on
+// down (idx permuted in place, the set kept). Each point sees the nodes its own query would, in
+// the same order.
+void batch_descend(const WindingNumberTree& tree, std::uint32_t at, std::span<const Vec3d> points,
+                   double beta2, std::uint32_t* idx, std::size_t b, std::size_t e, double* omega) {
+  const Node& node = tree.nodes[at];
+  const double limit = beta2 * node.radius * node.radius;
+  std::size_t near = b;
+  for (std::size_t k = b; k < e; ++k) {
+    const Vec3d d = node.center - points[idx[k]];
+    if (dot(d, d) > limit) omega[idx[k]] += far_field(node, tree.expansions[at], points[idx[k]]);
+    else std::swap(idx[near++], idx[k]);
+  }
+  if (near == b) return;
+  if (node.leaf) {
+    for (std::size_t k = b; k < near; ++k)
+      for (std::uint32_t i = node.left; i < node.right; ++i) {
+        const auto& t = tree.corners[i];
+        omega[idx[k]] += fast_triangle_solid_angle(points[idx[k]], t[0], t[1], t[2]);
+      }
+    return;
+  }
+  batch_descend(tree, node.left, points, beta2, idx, b, near, omega);
+  batch_descend(tree, node.right, points, beta2, idx, b, near, omega);
+}
+
+}  // namespace
+
+void winding_numbers(const WindingNumberTree& tree, std::span<const Vec3d> points, double beta,
+                     std::span<double> out) {
+  std::fill(out.begin(), out.end(), 0.0);
+  if (tree.nodes.empty() || points.empty()) return;
+  std::vector<std::uint32_t> idx(points.size());
+  for (std::size_t i = 0; i < idx.size(); ++i) idx[i] = std::uint32_t(i);
+  batch_descend(tree, 0, points, beta * beta, idx.data(), 0, idx.size(), out.data());
+  for (double& w : out) w /= 4.0 * std::numbers::pi;
+}
+
 double winding_number_exact(const TriangleMesh& mesh, const Vec3d& p) {
   double omega = 0.0;
   for (const auto& f : mesh.triangles)

@@ -165,5 +165,29 @@ TEST(WindingNumber, BuildRejectsBadInput) {
   }
 }
 
+TEST(WindingNumber, BatchEqualsTheSingleQueriesBitForBit) {
+  const TriangleMesh knot = test::load_cgal_mesh("knot.off");
+  const WindingNumberTree tree = build_winding_tree(knot);
+  // A brick-sized cluster of points near the surface, and points spread over the box.
+  const BBox box = knot.bounds();
+  const double h = box.longest_side() / 64.0;
+  std::vector<Vec3d> points;
+  const Vec3d corner = knot.vertices[0] - Vec3d{4, 4, 4} * h;
+  for (int k = 0; k < 8; ++k)
+    for (int j = 0; j < 8; ++j)
+      for (int i = 0; i < 8; ++i) points.push_back(corner + Vec3d{double(i), double(j), double(k)} * h);
+  const std::vector<Vec3d> spread = sample_points(knot, 300, 0.0, 5);
+  points.insert(points.end(), spread.begin(), spread.end());
+  for (const double beta : {2.0, 3.0}) {
+    std::vector<double> batch(points.size());
+    winding_numbers(tree, points, beta, batch);
+    int differ = 0;
+    for (std::size_t i = 0; i < points.size(); ++i) differ += batch[i] != winding_number(tree, points[i], beta);
+    EXPECT_EQ(differ, 0) << "beta " << beta;
+  }
+  std::vector<double> none;
+  winding_numbers(tree, {}, 2.0, none);  // an empty batch is fine
+}
+
 }  // namespace
 }  // namespace levelset
