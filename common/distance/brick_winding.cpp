@@ -159,6 +159,29 @@ struct Adaptive {
     return value[n];
   }
 
+  // Direct values of the listed voxels not yet known, in one tree traversal (winding_numbers:
+  // the same values as one query each). Voxels on the surface are left to surface_value.
+  void prefetch(std::span<const int> voxels) {
+    std::array<int, kBrickVoxels> wanted;
+    std::array<Vec3d, kBrickVoxels> points;
+    std::size_t count = 0;
+    const Coord o = brick_origin(brick);
+    for (const int n : voxels) {
+      if (known.test(n) || x.on_surface.test(n)) continue;
+      known.set(n);  // each once, even if listed twice
+      const Coord g = o + local_coord(n);
+      wanted[count] = n;
+      points[count++] = context.frame.origin +
+                        Vec3d{double(g.x), double(g.y), double(g.z)} * context.frame.voxel_size;
+    }
+    if (count == 0) return;
+    std::array<double, kBrickVoxels> values;
+    winding_numbers(context.tree.get(), std::span(points.data(), count), context.beta,
+                    std::span(values.data(), count));
+    for (std::size_t i = 0; i < count; ++i) value[std::size_t(wanted[i])] = values[i];
+    queries += count;
+  }
+
   // A voxel exactly on the surface: a neighbour off the surface plus the exact jump.
   double surface_value(int n) {
     const Coord c = local_coord(n);
@@ -190,6 +213,17 @@ struct Adaptive {
   // unflagged, where the model follows no side). `checked`: voxels modelled within
   // kAmbiguousBand of 1/2 are queried directly.
   void write_inside(const Coord& lo, int s, const double* modelled, bool checked) {
+    if (checked) {
+      std::array<int, kBrickVoxels> ambiguous;
+      std::size_t count = 0;
+      for (int k = lo.z; k < lo.z + s; ++k)
+        for (int j = lo.y; j < lo.y + s; ++j)
+          for (int i = lo.x; i < lo.x + s; ++i) {
+            const int n = local_index(i, j, k);
+            if (std::abs(modelled[n] - 0.5) < kAmbiguousBand) ambiguous[count++] = n;
+          }
+      prefetch(std::span(ambiguous.data(), count));
+    }
     for (int k = lo.z; k < lo.z + s; ++k)
       for (int j = lo.y; j < lo.y + s; ++j)
         for (int i = lo.x; i < lo.x + s; ++i) {
@@ -236,6 +270,13 @@ struct Adaptive {
       return value_of(n) - known_at(n);
     };
     if (ref < 0 || jumps.on_surface.test(ref)) ref = corner(0);
+    const int c = s / 2;
+    const int centre = local_index(lo.x + c, lo.y + c, lo.z + c);
+    {
+      const int needed[10] = {ref,       centre,    corner(0), corner(1), corner(2),
+                              corner(3), corner(4), corner(5), corner(6), corner(7)};
+      prefetch(needed);
+    }
     propagate(jumps, local_coord(ref), lo, s, rel);
     const double wr = remainder(ref);
     double smooth[8];
@@ -250,8 +291,6 @@ struct Adaptive {
       const int n = local_index(i, j, k);
       return wr + rel[n] + m + known_at(n);
     };
-    const int c = s / 2;
-    const int centre = local_index(lo.x + c, lo.y + c, lo.z + c);
     if (std::abs(remainder(centre) + known_at(centre) - model(lo.x + c, lo.y + c, lo.z + c)) >
         kAdaptiveTolerance)
       return false;
