@@ -237,10 +237,10 @@ struct Adaptive {
         }
   }
 
-  // Models w over the block [lo, lo + s)^3 as known_part[n] (exact, per voxel; none: 0) + the value at ref
-  // + the integer jumps `jumps` along the path from ref + the trilinear interpolation of the
-  // corners' residuals. Accepted (inside bits written) when a direct query at the block centre
-  // agrees within kAdaptiveTolerance.
+  // Models w over the block [lo, lo + s)^3 as known_part[n] (exact, per voxel; none: 0) + the
+  // rest at ref + the integer jumps `jumps` along the path from ref + the trilinear
+  // interpolation of the corners' residuals. Accepted (inside bits written) when a direct query
+  // at the block centre agrees within kAdaptiveTolerance.
   bool model_block(const Coord& lo, int s, int ref, const BrickCrossings& jumps,
                    const double* known_part) {
     auto corner = [&](int bits) {
@@ -307,7 +307,8 @@ struct Adaptive {
   // the surface and of the reversed cone. False when no cone applies (no apex keeps its
   // segments clear, or a voxel lies exactly on a cone triangle) or the model fails.
   bool model_with_cone(const Coord& lo, int s, int ref) {
-    const std::optional<RimCone> cone = make_rim_cone(rims, lo, s, 0.5 * double(s), 0.5 * double(s));
+    const double half = 0.5 * double(s);
+    const std::optional<RimCone> cone = make_rim_cone(rims, lo, s, half, half);
     if (!cone) return false;
     const Coord origin = brick_origin(brick);
     const std::vector<GridTriangle> reversed = reversed_cone_triangles(*cone, origin);
@@ -346,8 +347,8 @@ struct Adaptive {
       for (int b = 0; b < 8; ++b) inside.assign(corner(b), value_of(corner(b)) > 0.5);
       return;
     }
-    // No open edge nearby: the jumps are path independent in the block and the rest of w is
-    // smooth there.
+    // No open edge within half the block's size: the jumps are path independent in the block
+    // and the rest of w is smooth there. Otherwise the same after subtracting the cone.
     if (rim_near(lo, s) ? model_with_cone(lo, s, ref) : model_block(lo, s, ref, x, nullptr))
       return;
     const int half = s / 2;

@@ -554,7 +554,8 @@ void scan_triangle_features(const TriangleMesh& mesh, const Adjacency& adj, std:
     // Subdivided degenerate faces (CGAL's degtri_sliding.off) scanned all three cylinders.
     int longest = 0;
     for (int k = 1; k < 3; ++k)
-      if (length(tf.v[(k + 1) % 3] - tf.v[k]) > length(tf.v[(longest + 1) % 3] - tf.v[longest])) longest = k;
+      if (length(tf.v[(k + 1) % 3] - tf.v[k]) > length(tf.v[(longest + 1) % 3] - tf.v[longest]))
+        longest = k;
     const double twice_area = length(cross(tf.v[1] - tf.v[0], tf.v[2] - tf.v[0]));
     if (tf.scale > 0 && twice_area / tf.scale <= 1e-6 * scanner.voxel_size())
       for (int k = 0; k < 3; ++k) covered[k] = k != longest;

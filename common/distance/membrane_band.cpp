@@ -360,9 +360,11 @@ class Membranes {
           std::size_t count = 0;
           membrane_[k].for_each_set([&](int n) {
             const Coord g = o + local_coord(n);
-            points[count++] = o_.frame.origin + Vec3d{double(g.x), double(g.y), double(g.z)} * o_.frame.voxel_size;
+            points[count++] = o_.frame.origin +
+                              Vec3d{double(g.x), double(g.y), double(g.z)} * o_.frame.voxel_size;
           });
-          winding_numbers(tree_, std::span(points.data(), count), o_.beta, std::span(values.data(), count));
+          winding_numbers(tree_, std::span(points.data(), count), o_.beta,
+                          std::span(values.data(), count));
           count = 0;
           membrane_[k].for_each_set([&](int n) { wd[n] = float(values[count++]); });
           queries[d] += count;

@@ -165,7 +165,8 @@ std::vector<GridTriangle> reversed_cone_triangles(const RimCone& cone, const Coo
   std::vector<GridTriangle> out;
   out.reserve(cone.segments.size());
   const Vec3d apex = cone.apex + o;
-  for (const OpenSegment& e : cone.segments) out.push_back(make_grid_triangle(e[1] + o, e[0] + o, apex));
+  for (const OpenSegment& e : cone.segments)
+    out.push_back(make_grid_triangle(e[1] + o, e[0] + o, apex));
   return out;
 }
 
