@@ -362,7 +362,7 @@ struct Adaptive {
 
 }  // namespace
 
-ReferenceMasks inside_from_reference(std::span<const GridTriangle> triangles,
+BrickMask inside_from_reference(std::span<const GridTriangle> triangles,
                                 std::span<const std::uint32_t> ids, const Coord& brick,
                                 const BrickWindingContext& context, BrickCrossings& x,
                                 std::uint64_t& queries) {
@@ -422,14 +422,10 @@ ReferenceMasks inside_from_reference(std::span<const GridTriangle> triangles,
   const double w_ref = query(context, brick, r, queries);
   int rel[kBrickVoxels];
   propagate(x, local_coord(r), Coord{0, 0, 0}, kBrickDim, rel);
-  ReferenceMasks out;
-  out.closest_to_half = std::numeric_limits<double>::infinity();
-  for (int n = 0; n < kBrickVoxels; ++n) {
-    const double w = w_ref + rel[n];
-    if (w > 0.5) out.inside.set(n);
-    out.closest_to_half = std::min(out.closest_to_half, std::abs(w - 0.5));
-  }
-  return out;
+  BrickMask inside;
+  for (int n = 0; n < kBrickVoxels; ++n)
+    if (w_ref + rel[n] > 0.5) inside.set(n);
+  return inside;
 }
 
 std::array<int, kBrickVoxels> relative_winding(std::span<const GridTriangle> triangles,

@@ -30,9 +30,7 @@
 //   Voxels exactly on the surface are never queried (their direct value is the mean of the two
 //   sides); they take a neighbour's value plus the exact jump, following the perturbation
 //   convention. Cost: 9 queries per brick where the field is smooth, more near open edges.
-// Output of both: bit n set when w > 1/2; queries counts the tree evaluations made;
-// inside_from_reference also the smallest |w - 1/2| it found (how safe its unchecked
-// assumption of a constant continuous part was).
+// Output of both: bit n set when w > 1/2; queries counts the tree evaluations made.
 // relative_winding
 //   For closed meshes (every edge's uses cancel), with no query: every voxel's winding number
 //   minus that of the brick's base voxel (local 0, 0, 0), summing the jumps along the path
@@ -64,12 +62,7 @@ struct BrickWindingContext {
 };
 
 // Computes the crossings it needs into `scratch`.
-struct ReferenceMasks {
-  BrickMask inside;
-  double closest_to_half = 0.0;  // min over the voxels of |w - 1/2| (w as evaluated)
-};
-
-ReferenceMasks inside_from_reference(std::span<const GridTriangle> triangles,
+BrickMask inside_from_reference(std::span<const GridTriangle> triangles,
                                 std::span<const std::uint32_t> ids, const Coord& brick,
                                 const BrickWindingContext& context, BrickCrossings& scratch,
                                 std::uint64_t& queries);

@@ -36,8 +36,6 @@ std::size_t find_brick(const BrickTriangleLists& lists, const Coord& b) {
 // within a voxel, and the listed bricks within kOpenReach bricks of those (reach >= 16 voxels;
 // beyond it the continuous part of w changes by well under 1/2 across a brick).
 constexpr int kOpenReach = 2;
-// Bricks beyond the reach whose reference values come this close to 1/2 are modelled anyway.
-constexpr double kReferenceMargin = 0.25;
 
 struct OpenEdgeInfo {
   std::vector<std::uint8_t> triangle_edges;  // bit k: edge (f[k], f[k+1]) is open
@@ -327,7 +325,6 @@ InsideMasksResult compute_inside_masks(const TriangleMesh& oriented_mesh,
   result.inside.resize(nb);
   const BrickWindingContext context{tree, frame, options.beta};
   std::vector<std::uint64_t> queries(nb, 0);
-  std::vector<std::uint8_t> adaptive_again(nb, 0);
   for (std::size_t start = 0; start < nb; start += kBatchBricks) {
     const std::size_t end = std::min(nb, start + kBatchBricks);
     tbb::parallel_for(
@@ -340,26 +337,23 @@ InsideMasksResult compute_inside_masks(const TriangleMesh& oriented_mesh,
           for (std::size_t i = range.begin(); i != range.end(); ++i) {
             const std::span<const std::uint32_t> ids(lists.triangles.data() + lists.offsets[i],
                                                      lists.offsets[i + 1] - lists.offsets[i]);
-            if (!unsafe[i]) {
-              const ReferenceMasks r =
+            if (unsafe[i]) {
+              crossings = BrickCrossings{};
+              brick_crossings(grid, ids, lists.bricks[i], kAllLines, crossings);
+              gather_rims(lists, i, grid, open, frame.voxel_size, scratch, rims);
+              result.inside[i] =
+                  inside_adaptive(crossings, lists.bricks[i], rims, context, queries[i]);
+            } else {
+              result.inside[i] =
                   inside_from_reference(grid, ids, lists.bricks[i], context, crossings, queries[i]);
-              result.inside[i] = r.inside;
-              // An open surface's continuous part can still vary across a brick far from its
-              // rims (beside a wide sheet w stays near 1/2): there the brick is modelled.
-              if (open.count == 0 || r.closest_to_half >= kReferenceMargin) continue;
-              ++adaptive_again[i];
             }
-            crossings = BrickCrossings{};
-            brick_crossings(grid, ids, lists.bricks[i], kAllLines, crossings);
-            gather_rims(lists, i, grid, open, frame.voxel_size, scratch, rims);
-            result.inside[i] = inside_adaptive(crossings, lists.bricks[i], rims, context, queries[i]);
           }
         });
     options.progress.step(double(end) / double(nb), "sign");
   }
   for (std::size_t i = 0; i < nb; ++i) {
     result.winding_queries += queries[i];
-    result.direct_bricks += unsafe[i] || adaptive_again[i];
+    result.direct_bricks += unsafe[i];
   }
   return result;
 }
