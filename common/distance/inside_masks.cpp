@@ -32,9 +32,10 @@ std::size_t find_brick(const BrickTriangleLists& lists, const Coord& b) {
                                                            : nb;
 }
 
-// Open edges (open_edges.hpp) per triangle, and the bricks near them: those with an open edge
-// within a voxel, and the listed bricks within kOpenReach bricks of those (reach >= 16 voxels;
-// beyond it the continuous part of w changes by well under 1/2 across a brick).
+// Open edges (open_edges.hpp) per triangle, and the bricks near them: those a triangle with an
+// open edge comes near (its bounding box), and the listed bricks within kOpenReach bricks of
+// those (reach >= 16 voxels; beyond it the continuous part of w changes by well under 1/2
+// across a brick).
 constexpr int kOpenReach = 2;
 
 struct OpenEdgeInfo {
@@ -69,20 +70,31 @@ OpenEdgeInfo find_open_edges(const TriangleMesh& mesh, std::span<const Vec3d> gr
       }
     }
   });
-  for (std::size_t i = 0; i < nb; ++i) {
-    // An open edge meeting the brick's voxel-centre box grown by one voxel (not just a listed
-    // triangle with one: the masks then do not depend on the lists' margin, given >= h).
-    const Coord o = brick_origin(lists.bricks[i]);
-    const Vec3d lo = Vec3d{double(o.x), double(o.y), double(o.z)} - Vec3d{1, 1, 1};
-    const Vec3d hi = lo + Vec3d{1, 1, 1} * double(kBrickDim + 1);
-    bool core = false;
-    for (std::uint64_t k = lists.offsets[i]; k < lists.offsets[i + 1] && !core; ++k) {
-      const std::uint32_t t = lists.triangles[k];
-      for (int e = 0; e < 3 && !core; ++e)
-        core = ((info.triangle_edges[t] >> e) & 1u) &&
-               segment_meets_box(grid[t].corner[e], grid[t].corner[(e + 1) % 3], lo, hi);
+  // Cores: the listed bricks whose voxel-centre box, grown by one voxel, meets the bounding box
+  // of a triangle with an open edge (found from the triangles, so the choice does not depend on
+  // the lists' margin; a big border triangle marks every brick along it, as beside a wide
+  // sheet the continuous part varies across bricks far from the edge itself).
+  std::vector<bool> core(nb, false);
+  for (std::size_t t = 0; t < nt; ++t) {
+    if (!info.triangle_edges[t]) continue;
+    const GridTriangle& g = grid[t];
+    Coord lo, hi;
+    for (int a = 0; a < 3; ++a) {
+      const double mn = std::min({g.corner[0][a], g.corner[1][a], g.corner[2][a]}) - 1.0;
+      const double mx = std::max({g.corner[0][a], g.corner[1][a], g.corner[2][a]}) + 1.0;
+      const double lim = double(kVoxelCoordLimit - 1);
+      lo[a] = int(std::floor(std::clamp(mn, -lim, lim))) >> kBrickLog2;
+      hi[a] = int(std::floor(std::clamp(mx, -lim, lim))) >> kBrickLog2;
     }
-    if (!core) continue;
+    for (int z = lo.z; z <= hi.z; ++z)
+      for (int y = lo.y; y <= hi.y; ++y)
+        for (int x = lo.x; x <= hi.x; ++x) {
+          const std::size_t j = find_brick(lists, Coord{x, y, z});
+          if (j < nb) core[j] = true;
+        }
+  }
+  for (std::size_t i = 0; i < nb; ++i) {
+    if (!core[i]) continue;
     for (int dz = -kOpenReach; dz <= kOpenReach; ++dz)
       for (int dy = -kOpenReach; dy <= kOpenReach; ++dy)
         for (int dx = -kOpenReach; dx <= kOpenReach; ++dx) {
