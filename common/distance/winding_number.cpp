@@ -1,6 +1,7 @@
 #include "distance/winding_number.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <numbers>
 #include <string>
@@ -291,9 +292,12 @@ void winding_numbers(const WindingNumberTree& tree, std::span<const Vec3d> point
                      std::span<double> out) {
   std::fill(out.begin(), out.end(), 0.0);
   if (tree.nodes.empty() || points.empty()) return;
-  std::vector<std::uint32_t> idx(points.size());
-  for (std::size_t i = 0; i < idx.size(); ++i) idx[i] = std::uint32_t(i);
-  batch_descend(tree, 0, points, beta * beta, idx.data(), 0, idx.size(), out.data());
+  // Small batches (a brick's voxels, the callers' case) index from the stack: no allocation.
+  std::array<std::uint32_t, 512> local;
+  std::vector<std::uint32_t> heap(points.size() > local.size() ? points.size() : 0);
+  std::uint32_t* idx = heap.empty() ? local.data() : heap.data();
+  for (std::size_t i = 0; i < points.size(); ++i) idx[i] = std::uint32_t(i);
+  batch_descend(tree, 0, points, beta * beta, idx, 0, points.size(), out.data());
   for (double& w : out) w /= 4.0 * std::numbers::pi;
 }
 
