@@ -38,6 +38,7 @@ struct Builder {
   std::vector<double> area;        // per mesh triangle
   std::vector<std::uint32_t> ids;  // permuted mesh triangle indices
   WindingNumberTree& tree;
+  std::vector<Expansion> moments;  // per node
 
   // Leaf moments directly from its triangles about the area-weighted centroid.
   void make_leaf(Node& node, Expansion& ex, std::size_t lo, std::size_t hi) {
@@ -89,7 +90,7 @@ struct Builder {
     node.center = total > 0.0 ? (nl.center * area_l + nr.center * area_r) / total
                               : (nl.center + nr.center) * 0.5;
     for (std::size_t c : {l, r}) {
-      const Expansion& child = tree.expansions[c];
+      const Expansion& child = moments[c];
       const Vec3d d = tree.nodes[c].center - node.center;
       ex.normal += child.normal;
       for (int i = 0; i < 3; ++i) {
@@ -114,7 +115,7 @@ struct Builder {
   // Builds the subtree of ids[lo, hi) at node index `at`; returns its total area.
   double build(std::size_t at, std::size_t lo, std::size_t hi) {
     Node& node = tree.nodes[at];
-    Expansion& ex = tree.expansions[at];
+    Expansion& ex = moments[at];
     const std::size_t n = hi - lo;
     if (n <= std::size_t(kLeaf)) {
       make_leaf(node, ex, lo, hi);
@@ -153,39 +154,56 @@ struct Builder {
   }
 };
 
-// Solid angle of a node's triangles seen from p by the second-order expansion about its centre.
-double far_field(const Node& node, const Expansion& ex, const Vec3d& p) {
-  const Vec3d y = node.center - p;
-  const double r2 = dot(y, y);
-  const double inv_r = 1.0 / std::sqrt(r2);
-  const double inv_r2 = inv_r * inv_r;
-  const double inv_r3 = inv_r2 * inv_r;
-  const double inv_r5 = inv_r3 * inv_r2;
-  const double inv_r7 = inv_r5 * inv_r2;
+// The far-field polynomial of a node's moments (WindingNumberTree::FarField): the second-order
+// expansion 1/r^3 [N.y + tr M] - 3/r^5 [y^T M y + 1/2 l.y] + 15/(2 r^7) sum_i y_i y^T C_i y,
+// its monomials' coefficients collected once.
+WindingNumberTree::FarField far_form(const Expansion& ex) {
+  WindingNumberTree::FarField f;
   const auto& m = ex.first;
-  const auto& c = ex.second;
-  // Zeroth order (dipole).
-  double omega = dot(ex.normal, y) * inv_r3;
-  // First order: tr(M)/r^3 - 3 y^T M y / r^5.
-  double ymy = 0.0;
-  for (int i = 0; i < 3; ++i)
-    ymy += y[i] * (m[i * 3 + 0] * y.x + m[i * 3 + 1] * y.y + m[i * 3 + 2] * y.z);
-  omega += (m[0] + m[4] + m[8]) * inv_r3 - 3.0 * ymy * inv_r5;
-  // Second order: 1/2 [ -3/r^5 (2 sum_ik C_i(ik) y_k + sum_i y_i tr C_i) + 15/r^7 sum_i y_i y^T C_i
-  // y ].
-  double lin = 0.0, cubic = 0.0;
-  for (int i = 0; i < 3; ++i) {
-    const double* ci = &c[std::size_t(i) * 6];
-    // Row i of the symmetric matrix C_i: entries (i, k).
-    const double row[3][3] = {{ci[0], ci[3], ci[4]}, {ci[3], ci[1], ci[5]}, {ci[4], ci[5], ci[2]}};
-    lin += 2.0 * (row[i][0] * y.x + row[i][1] * y.y + row[i][2] * y.z) +
-           y[i] * (ci[0] + ci[1] + ci[2]);
-    const double yCy = ci[0] * y.x * y.x + ci[1] * y.y * y.y + ci[2] * y.z * y.z +
-                       2.0 * (ci[3] * y.x * y.y + ci[4] * y.x * y.z + ci[5] * y.y * y.z);
-    cubic += y[i] * yCy;
+  f.normal = ex.normal;
+  f.trace = m[0] + m[4] + m[8];
+  // y^T M y with M's symmetric part.
+  f.quad = {3.0 * m[0], 3.0 * m[4], 3.0 * m[8], 3.0 * (m[1] + m[3]), 3.0 * (m[2] + m[6]), 3.0 * (m[5] + m[7])};
+  // Entry (j, k) of the symmetric C_i.
+  auto C = [&](int i, int j, int k) {
+    static constexpr int kSlot[3][3] = {{0, 3, 4}, {3, 1, 5}, {4, 5, 2}};
+    return ex.second[std::size_t(i * 6 + kSlot[j][k])];
+  };
+  for (int k = 0; k < 3; ++k) {
+    double l = C(k, 0, 0) + C(k, 1, 1) + C(k, 2, 2);
+    for (int i = 0; i < 3; ++i) l += 2.0 * C(i, i, k);
+    f.lin[k] = 1.5 * l;
   }
-  omega += 0.5 * (-3.0 * lin * inv_r5 + 15.0 * cubic * inv_r7);
-  return omega;
+  enum { X, Y, Z };
+  const double cubic[10] = {C(X, X, X),
+                            C(Y, Y, Y),
+                            C(Z, Z, Z),
+                            C(Y, X, X) + 2.0 * C(X, X, Y),
+                            C(Z, X, X) + 2.0 * C(X, X, Z),
+                            C(X, Y, Y) + 2.0 * C(Y, X, Y),
+                            C(Z, Y, Y) + 2.0 * C(Y, Y, Z),
+                            C(X, Z, Z) + 2.0 * C(Z, X, Z),
+                            C(Y, Z, Z) + 2.0 * C(Z, Y, Z),
+                            2.0 * (C(X, Y, Z) + C(Y, X, Z) + C(Z, X, Y))};
+  for (int i = 0; i < 10; ++i) f.cubic[std::size_t(i)] = 7.5 * cubic[i];
+  return f;
+}
+
+// Solid angle of a node's triangles seen from p by the second-order expansion about its centre.
+double far_field(const Node& node, const WindingNumberTree::FarField& f, const Vec3d& p) {
+  const Vec3d y = node.center - p;
+  const double xx = y.x * y.x, yy = y.y * y.y, zz = y.z * y.z;
+  const double xy = y.x * y.y, xz = y.x * y.z, yz = y.y * y.z;
+  const double r2 = xx + yy + zz;
+  const double inv_r2 = 1.0 / r2;
+  const double inv_r3 = inv_r2 / std::sqrt(r2);
+  const double q1 = f.normal.x * y.x + f.normal.y * y.y + f.normal.z * y.z + f.trace;
+  const double q2 = f.quad[0] * xx + f.quad[1] * yy + f.quad[2] * zz + f.quad[3] * xy + f.quad[4] * xz +
+                    f.quad[5] * yz + f.lin.x * y.x + f.lin.y * y.y + f.lin.z * y.z;
+  const double q3 = (f.cubic[0] * xx + f.cubic[3] * xy + f.cubic[4] * xz + f.cubic[5] * yy + f.cubic[7] * zz +
+                     f.cubic[9] * yz) * y.x +
+                    (f.cubic[1] * yy + f.cubic[6] * yz + f.cubic[8] * zz) * y.y + f.cubic[2] * zz * y.z;
+  return (q1 + (q3 * inv_r2 - q2) * inv_r2) * inv_r3;
 }
 
 }  // namespace
@@ -206,7 +224,7 @@ WindingNumberTree build_winding_tree(const TriangleMesh& mesh) {
   WindingNumberTree tree;
   if (nt == 0) return tree;
   Builder b{mesh, std::vector<Vec3d>(nt), std::vector<double>(nt), std::vector<std::uint32_t>(nt),
-            tree};
+            tree, {}};
   for (std::size_t t = 0; t < nt; ++t) {
     const auto& f = mesh.triangles[t];
     const Vec3d& p = mesh.vertices[f[0]];
@@ -217,10 +235,12 @@ WindingNumberTree build_winding_tree(const TriangleMesh& mesh) {
     b.ids[t] = std::uint32_t(t);
   }
   tree.nodes.resize(node_count(nt));
-  tree.expansions.resize(tree.nodes.size());
+  b.moments.resize(tree.nodes.size());
   tree.corners.resize(nt);
   tree.order.resize(nt);
   b.build(0, 0, nt);
+  tree.far.resize(tree.nodes.size());
+  for (std::size_t i = 0; i < tree.nodes.size(); ++i) tree.far[i] = far_form(b.moments[i]);
   return tree;
 }
 
@@ -244,7 +264,7 @@ double winding_number(const WindingNumberTree& tree, const Vec3d& p, double beta
     const Node& node = tree.nodes[at];
     const Vec3d d = node.center - p;
     if (dot(d, d) > beta2 * node.radius * node.radius) {
-      omega += far_field(node, tree.expansions[at], p);
+      omega += far_field(node, tree.far[at], p);
     } else if (node.leaf) {
       for (std::uint32_t i = node.left; i < node.right; ++i) {
         const auto& t = tree.corners[i];
@@ -260,26 +280,66 @@ double winding_number(const WindingNumberTree& tree, const Vec3d& p, double beta
 
 namespace {
 
+// Lanes of the batch evaluations below: a chunk of points in coordinate arrays.
+constexpr int kChunk = 32;
+
+// far_field of one node at n points; each lane computes the scalar form's operations in its
+// order (no contraction, see CMakeLists.txt), so the batch equals the single queries bit for bit.
+__attribute__((target_clones("avx512f", "avx2", "default")))
+void far_block(const Node& node, const WindingNumberTree::FarField& f, const double* px, const double* py,
+               const double* pz, int n, double* out) {
+  for (int i = 0; i < n; ++i) out[i] = far_field(node, f, Vec3d{px[i], py[i], pz[i]});
+}
+
+// acc[i] += the solid angles of a leaf's triangles at point i, triangle by triangle (the single
+// query's order of sums).
+__attribute__((target_clones("avx512f", "avx2", "default")))
+void leaf_block(const std::array<Vec3d, 3>* triangles, std::uint32_t count, const double* px, const double* py,
+                const double* pz, int n, double* acc) {
+  for (std::uint32_t t = 0; t < count; ++t) {
+    const std::array<Vec3d, 3>& c = triangles[t];
+    for (int i = 0; i < n; ++i) acc[i] += fast_triangle_solid_angle(Vec3d{px[i], py[i], pz[i]}, c[0], c[1], c[2]);
+  }
+}
+
 // Points idx[b, e) have reached node `at`: those far from it take its expansion, the rest go on
 // down (idx permuted in place, the set kept). Each point sees the nodes its own query would, in
-// the same order.
+// the same order. Expansions and leaves are evaluated kChunk points at a time.
 void batch_descend(const WindingNumberTree& tree, std::uint32_t at, std::span<const Vec3d> points,
                    double beta2, std::uint32_t* idx, std::size_t b, std::size_t e, double* omega) {
   const Node& node = tree.nodes[at];
   const double limit = beta2 * node.radius * node.radius;
+  alignas(64) double px[kChunk], py[kChunk], pz[kChunk], value[kChunk];
+  std::uint32_t which[kChunk];
+  int n = 0;
+  auto flush_far = [&] {
+    far_block(node, tree.far[at], px, py, pz, n, value);
+    for (int i = 0; i < n; ++i) omega[which[i]] += value[i];
+    n = 0;
+  };
   std::size_t near = b;
   for (std::size_t k = b; k < e; ++k) {
-    const Vec3d d = node.center - points[idx[k]];
-    if (dot(d, d) > limit) omega[idx[k]] += far_field(node, tree.expansions[at], points[idx[k]]);
-    else std::swap(idx[near++], idx[k]);
+    const Vec3d& p = points[idx[k]];
+    const Vec3d d = node.center - p;
+    if (dot(d, d) > limit) {
+      px[n] = p.x, py[n] = p.y, pz[n] = p.z, which[n] = idx[k];
+      if (++n == kChunk) flush_far();
+    } else {
+      std::swap(idx[near++], idx[k]);
+    }
   }
+  if (n > 0) flush_far();
   if (near == b) return;
   if (node.leaf) {
-    for (std::size_t k = b; k < near; ++k)
-      for (std::uint32_t i = node.left; i < node.right; ++i) {
-        const auto& t = tree.corners[i];
-        omega[idx[k]] += fast_triangle_solid_angle(points[idx[k]], t[0], t[1], t[2]);
+    for (std::size_t k0 = b; k0 < near; k0 += kChunk) {
+      const int m = int(std::min<std::size_t>(kChunk, near - k0));
+      for (int i = 0; i < m; ++i) {
+        const Vec3d& p = points[idx[k0 + std::size_t(i)]];
+        px[i] = p.x, py[i] = p.y, pz[i] = p.z, value[i] = omega[idx[k0 + std::size_t(i)]];
       }
+      leaf_block(&tree.corners[node.left], node.right - node.left, px, py, pz, m, value);
+      for (int i = 0; i < m; ++i) omega[idx[k0 + std::size_t(i)]] = value[i];
+    }
     return;
   }
   batch_descend(tree, node.left, points, beta2, idx, b, near, omega);

@@ -14,7 +14,8 @@
 //   up to second order: the area-weighted normal sum N (dipole), the first moment
 //   M = sum a n (x - c)^T and the second moment C = sum a n (x - c)(x - c)^T, both integrated
 //   over the triangles (their own extent included).
-//   Cost: O(F log F) time, ~0.4 KB per leaf plus 72 bytes per triangle. Threading: TBB
+//   Cost: O(F log F) time, ~0.4 KB per leaf plus 72 bytes per triangle (the build's moments,
+//   0.5 KB per leaf, are freed). Threading: TBB
 //   (parallel recursion); the tree is identical for any thread count.
 //   Errors: Error{InvalidArgument} for vertex indices out of range, Error{NonFinite} for
 //   non-finite vertices.
@@ -64,14 +65,24 @@ struct WindingNumberTree {
     std::uint32_t right = 0;  // [left, right) in corners
     bool leaf = false;
   };
-  struct Expansion {                  // what it reads for nodes it approximates
+  struct Expansion {                  // the moments the build accumulates (not kept)
     Vec3d normal;                     // sum of area-weighted normals, 1/2 (b - a) x (c - a)
     std::array<double, 9> first{};    // M[i*3+j] = sum a n_i (x - c)_j        (integrated)
     std::array<double, 18> second{};  // C[i*6+s] = sum a n_i (x - c)_j (x - c)_k, s = jk in
                                       // xx, yy, zz, xy, xz, yz               (integrated)
   };
+  // The expansion as a polynomial in y = center - p, what the traversal reads for nodes it
+  // approximates: solid angle = (q1 + (q3 / r^2 - q2) / r^2) / r^3 with q1 = N.y + tr M,
+  // q2 = 3 y^T M y + 3/2 l.y, q3 = 15/2 sum_i y_i y^T C_i y (23 numbers instead of 30).
+  struct FarField {
+    Vec3d normal;                   // N
+    double trace = 0.0;             // tr M
+    std::array<double, 6> quad{};   // q2's coefficients of xx, yy, zz, xy, xz, yz
+    Vec3d lin;                      // 3/2 l, l_k = 2 sum_i (C_i)_ik + tr C_k
+    std::array<double, 10> cubic{}; // q3's coefficients of xxx, yyy, zzz, xxy, xxz, yyx, yyz, zzx, zzy, xyz
+  };
   std::vector<Node> nodes;                    // nodes[0] is the root (empty mesh: no nodes)
-  std::vector<Expansion> expansions;          // per node
+  std::vector<FarField> far;                  // per node
   std::vector<std::array<Vec3d, 3>> corners;  // triangle vertices in leaf order
   std::vector<std::uint32_t> order;           // mesh triangle index of corners[i]
 };

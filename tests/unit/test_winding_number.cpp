@@ -128,7 +128,8 @@ TEST(WindingNumber, SoupsFlippedFacesAndEmptyMesh) {
   EXPECT_EQ(one.order, two.order);
   for (std::size_t i = 0; i < one.nodes.size(); ++i) {
     EXPECT_EQ(one.nodes[i].center, two.nodes[i].center);
-    EXPECT_EQ(one.expansions[i].second, two.expansions[i].second);
+    EXPECT_EQ(one.far[i].cubic, two.far[i].cubic);
+    EXPECT_EQ(one.far[i].quad, two.far[i].quad);
   }
 }
 
