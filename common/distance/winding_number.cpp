@@ -17,7 +17,13 @@ namespace levelset {
 namespace {
 
 using Node = WindingNumberTree::Node;
-using Expansion = WindingNumberTree::Expansion;
+// The moments the build accumulates per node (converted to WindingNumberTree::FarField).
+struct Expansion {
+  Vec3d normal;                     // sum of area-weighted normals, 1/2 (b - a) x (c - a)
+  std::array<double, 9> first{};    // M[i*3+j] = sum a n_i (x - c)_j        (integrated)
+  std::array<double, 18> second{};  // C[i*6+s] = sum a n_i (x - c)_j (x - c)_k, s = jk in
+                                    // xx, yy, zz, xy, xz, yz               (integrated)
+};
 constexpr int kLeaf = WindingNumberTree::kLeafTriangles;
 constexpr std::size_t kParallelGrain = 4096;  // triangles below which a subtree builds serially
 

@@ -65,21 +65,16 @@ struct WindingNumberTree {
     std::uint32_t right = 0;  // [left, right) in corners
     bool leaf = false;
   };
-  struct Expansion {                  // the moments the build accumulates (not kept)
-    Vec3d normal;                     // sum of area-weighted normals, 1/2 (b - a) x (c - a)
-    std::array<double, 9> first{};    // M[i*3+j] = sum a n_i (x - c)_j        (integrated)
-    std::array<double, 18> second{};  // C[i*6+s] = sum a n_i (x - c)_j (x - c)_k, s = jk in
-                                      // xx, yy, zz, xy, xz, yz               (integrated)
-  };
-  // The expansion as a polynomial in y = center - p, what the traversal reads for nodes it
-  // approximates: solid angle = (q1 + (q3 / r^2 - q2) / r^2) / r^3 with q1 = N.y + tr M,
+  // The node's expansion (its moments N, M, C about center, see above) as a polynomial in
+  // y = center - p, what the traversal reads for nodes it approximates: solid angle = (q1 + (q3 / r^2 - q2) / r^2) / r^3 with q1 = N.y + tr M,
   // q2 = 3 y^T M y + 3/2 l.y, q3 = 15/2 sum_i y_i y^T C_i y (23 numbers instead of 30).
   struct FarField {
     Vec3d normal;                   // N
     double trace = 0.0;             // tr M
     std::array<double, 6> quad{};   // q2's coefficients of xx, yy, zz, xy, xz, yz
     Vec3d lin;                      // 3/2 l, l_k = 2 sum_i (C_i)_ik + tr C_k
-    std::array<double, 10> cubic{}; // q3's coefficients of xxx, yyy, zzz, xxy, xxz, yyx, yyz, zzx, zzy, xyz
+    std::array<double, 10> cubic{}; // q3's coefficients of x^3, y^3, z^3, x^2 y, x^2 z, y^2 x, y^2 z,
+                                    // z^2 x, z^2 y, x y z
   };
   std::vector<Node> nodes;                    // nodes[0] is the root (empty mesh: no nodes)
   std::vector<FarField> far;                  // per node
