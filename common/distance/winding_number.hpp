@@ -14,8 +14,8 @@
 //   up to second order: the area-weighted normal sum N (dipole), the first moment
 //   M = sum a n (x - c)^T and the second moment C = sum a n (x - c)(x - c)^T, both integrated
 //   over the triangles (their own extent included).
-//   Cost: O(F log F) time, ~0.4 KB per leaf plus 72 bytes per triangle (the build's moments,
-//   0.5 KB per leaf, are freed). Threading: TBB
+//   Cost: O(F log F) time, ~0.45 KB per leaf (two nodes) plus 72 bytes per triangle; the
+//   build's moments (~0.5 KB per leaf) are freed after it. Threading: TBB
 //   (parallel recursion); the tree is identical for any thread count.
 //   Errors: Error{InvalidArgument} for vertex indices out of range, Error{NonFinite} for
 //   non-finite vertices.
@@ -66,8 +66,9 @@ struct WindingNumberTree {
     bool leaf = false;
   };
   // The node's expansion (its moments N, M, C about center, see above) as a polynomial in
-  // y = center - p, what the traversal reads for nodes it approximates: solid angle = (q1 + (q3 / r^2 - q2) / r^2) / r^3 with q1 = N.y + tr M,
-  // q2 = 3 y^T M y + 3/2 l.y, q3 = 15/2 sum_i y_i y^T C_i y (23 numbers instead of 30).
+  // y = center - p, what the traversal reads for nodes it approximates: solid angle
+  // = (q1 + (q3 / r^2 - q2) / r^2) / r^3 with q1 = N.y + tr M, q2 = 3 y^T M y + 3/2 l.y and
+  // q3 = 15/2 sum_i y_i y^T C_i y (23 numbers instead of the moments' 30).
   struct FarField {
     Vec3d normal;                   // N
     double trace = 0.0;             // tr M

@@ -235,7 +235,7 @@ inline int best_fan_start(const Vec3d* p, int n) {
       const Vec3d e = p[j] - p[i];
       d2[i][j] = d2[j][i] = float(dot(e, e));
     }
-  const int per = n - 2, count = n * per;
+  const int per = n - 2;
   alignas(16) float sa[124], sb[124], sc[124], cosine[124];  // count <= 120, padded to 4
   int t = 0;
   for (int s = 0; s < n; ++s)
@@ -269,7 +269,6 @@ inline int best_fan_start(const Vec3d* p, int n) {
       best = s;
     }
   }
-  (void)count;
   return best;
 }
 
