@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <array>
+#include <span>
 #include <bit>
 #include <cmath>
 #include <limits>
@@ -106,15 +107,36 @@ struct FarBrick {
     return w[std::size_t(n)];
   }
 
+  // The direct values of the listed voxels not yet known, in one tree traversal
+  // (winding_numbers: the values of one query each).
+  void prefetch(std::span<const int> voxels) {
+    std::array<int, kBrickVoxels> wanted;
+    std::array<Vec3d, kBrickVoxels> points;
+    std::size_t count = 0;
+    for (const int n : voxels) {
+      if (known.test(n)) continue;
+      known.set(n);
+      const Coord g = origin + local_coord(n);
+      wanted[count] = n;
+      points[count++] = frame.origin + Vec3d{double(g.x), double(g.y), double(g.z)} * frame.voxel_size;
+    }
+    if (count == 0) return;
+    std::array<double, kBrickVoxels> values;
+    winding_numbers(tree, std::span(points.data(), count), beta, std::span(values.data(), count));
+    for (std::size_t i = 0; i < count; ++i) w[std::size_t(wanted[i])] = float(values[i]);
+    queries += count;
+  }
+
   void solve(const Coord& lo, int s) {
     auto corner = [&](int b) {
       return local_index(lo.x + ((b & 1) ? s - 1 : 0), lo.y + ((b & 2) ? s - 1 : 0),
                          lo.z + ((b & 4) ? s - 1 : 0));
     };
-    if (s == 2) {
-      for (int b = 0; b < 8; ++b) direct(corner(b));
-      return;
-    }
+    const int h = s / 2;
+    const int centre = local_index(lo.x + h, lo.y + h, lo.z + h);
+    const int first[9] = {corner(0), corner(1), corner(2), corner(3), corner(4), corner(5), corner(6), corner(7), centre};
+    prefetch(std::span(first, s == 2 ? 8 : 9));
+    if (s == 2) return;
     double c[8];
     for (int b = 0; b < 8; ++b) c[b] = direct(corner(b));
     auto model = [&](int i, int j, int k) {
@@ -125,18 +147,19 @@ struct FarBrick {
         m += c[b] * ((b & 1) ? tx : 1 - tx) * ((b & 2) ? ty : 1 - ty) * ((b & 4) ? tz : 1 - tz);
       return m;
     };
-    const int h = s / 2;
-    const int centre = local_index(lo.x + h, lo.y + h, lo.z + h);
     if (std::abs(double(direct(centre)) - model(lo.x + h, lo.y + h, lo.z + h)) <= kModelTolerance) {
+      std::array<int, kBrickVoxels> ambiguous;
+      std::size_t count = 0;
       for (int k = lo.z; k < lo.z + s; ++k)
         for (int j = lo.y; j < lo.y + s; ++j)
           for (int i = lo.x; i < lo.x + s; ++i) {
             const int n = local_index(i, j, k);
             if (known.test(n)) continue;
             const double m = model(i, j, k);
-            if (std::abs(m - 0.5) <= kDecisionMargin) direct(n);
+            if (std::abs(m - 0.5) <= kDecisionMargin) ambiguous[count++] = n;
             else w[std::size_t(n)] = float(m);
           }
+      prefetch(std::span(ambiguous.data(), count));
       return;
     }
     for (int b = 0; b < 8; ++b)
