@@ -60,6 +60,19 @@ std::vector<Vec3d> chain_ends(std::span<const OpenSegment> segments) {
   return ends;
 }
 
+// The segments reordered so that each continues the one before where it can (b of one = a of
+// the next): cone_winding_block then computes a shared end's vector once. Greedy, O(N^2) for
+// the few tens of segments near a block.
+void order_as_chains(std::vector<OpenSegment>& segments) {
+  const std::size_t n = segments.size();
+  for (std::size_t i = 0; i + 1 < n; ++i)
+    for (std::size_t j = i + 1; j < n; ++j)
+      if (segments[j][0] == segments[i][1]) {
+        std::swap(segments[i + 1], segments[j]);
+        break;
+      }
+}
+
 // 26 directions, slightly off the grid's symmetry planes so that no cone triangle lies in a
 // grid plane by construction.
 std::array<Vec3d, 26> make_directions() {
@@ -95,6 +108,7 @@ std::optional<RimCone> make_rim_cone(std::span<const OpenSegment> rims, const Co
     if (segment_meets_box(e[0], e[1], blo - grow_reach, bhi + grow_reach))
       cone.segments.push_back(e);
   if (cone.segments.empty()) return std::nullopt;
+  order_as_chains(cone.segments);
   const std::vector<Vec3d> ends = chain_ends(cone.segments);
   const Vec3d centre = 0.5 * (blo + bhi);
   for (const Vec3d& d : kDirections) {
@@ -135,20 +149,37 @@ void cone_winding_block(const RimCone& cone, const Coord& lo, int s, double* out
         pz[n] = double(lo.z + k);
         omega[n] = 0.0;
       }
-  const Vec3d& c = cone.apex;
+  // Per voxel: vertex - p and its length, for the apex (once) and for a segment's two ends (the
+  // end of one segment is the start of the next along a chain: swapped, not recomputed). The
+  // same operations as triangle_solid_angle(p, a, b, apex) term by term.
+  struct Ends {
+    double x[kBrickVoxels], y[kBrickVoxels], z[kBrickVoxels], l[kBrickVoxels];
+    void compute(const Vec3d& v, const double* px, const double* py, const double* pz, int count) {
+      for (int n = 0; n < count; ++n) {
+        x[n] = v.x - px[n], y[n] = v.y - py[n], z[n] = v.z - pz[n];
+        l[n] = std::sqrt(x[n] * x[n] + y[n] * y[n] + z[n] * z[n]);
+      }
+    }
+  };
+  Ends apex, first, second;
+  apex.compute(cone.apex, px, py, pz, count);
+  Ends* a_ends = &first;
+  Ends* b_ends = &second;
+  const OpenSegment* previous = nullptr;
   for (const OpenSegment& e : cone.segments) {
-    const Vec3d& a = e[0];
-    const Vec3d& b = e[1];
+    if (previous != nullptr && (*previous)[1] == e[0]) std::swap(a_ends, b_ends);
+    else a_ends->compute(e[0], px, py, pz, count);
+    b_ends->compute(e[1], px, py, pz, count);
+    previous = &e;
+    const Ends& A = *a_ends;
+    const Ends& B = *b_ends;
     for (int n = 0; n < count; ++n) {
-      // triangle_solid_angle(p, a, b, apex), term by term.
-      const double xx = a.x - px[n], xy = a.y - py[n], xz = a.z - pz[n];
-      const double yx = b.x - px[n], yy = b.y - py[n], yz = b.z - pz[n];
-      const double zx = c.x - px[n], zy = c.y - py[n], zz = c.z - pz[n];
+      const double xx = A.x[n], xy = A.y[n], xz = A.z[n];
+      const double yx = B.x[n], yy = B.y[n], yz = B.z[n];
+      const double zx = apex.x[n], zy = apex.y[n], zz = apex.z[n];
       const double det = xx * (yy * zz - yz * zy) + xy * (yz * zx - yx * zz) +
                          xz * (yx * zy - yy * zx);
-      const double lx = std::sqrt(xx * xx + xy * xy + xz * xz);
-      const double ly = std::sqrt(yx * yx + yy * yy + yz * yz);
-      const double lz = std::sqrt(zx * zx + zy * zy + zz * zz);
+      const double lx = A.l[n], ly = B.l[n], lz = apex.l[n];
       const double denom = lx * ly * lz + (xx * yx + xy * yy + xz * yz) * lz +
                            (yx * zx + yy * zy + yz * zz) * lx + (zx * xx + zy * xy + zz * xz) * ly;
       omega[n] += 2.0 * polynomial_atan2(det, denom);
