@@ -8,6 +8,7 @@
 #include <utility>
 #include <vector>
 
+#include "distance/voxel_winding.hpp"
 #include "geometry/point_triangle.hpp"
 
 namespace levelset {
@@ -163,21 +164,16 @@ struct Adaptive {
   // the same values as one query each). Voxels on the surface are left to surface_value.
   void prefetch(std::span<const int> voxels) {
     std::array<int, kBrickVoxels> wanted;
-    std::array<Vec3d, kBrickVoxels> points;
     std::size_t count = 0;
-    const Coord o = brick_origin(brick);
     for (const int n : voxels) {
       if (known.test(n) || x.on_surface.test(n)) continue;
       known.set(n);  // each once, even if listed twice
-      const Coord g = o + local_coord(n);
-      wanted[count] = n;
-      points[count++] = context.frame.origin +
-                        Vec3d{double(g.x), double(g.y), double(g.z)} * context.frame.voxel_size;
+      wanted[count++] = n;
     }
     if (count == 0) return;
     std::array<double, kBrickVoxels> values;
-    winding_numbers(context.tree.get(), std::span(points.data(), count), context.beta,
-                    std::span(values.data(), count));
+    voxel_winding_numbers(context.tree.get(), context.frame, brick_origin(brick), std::span(wanted.data(), count),
+                          context.beta, values);
     for (std::size_t i = 0; i < count; ++i) value[std::size_t(wanted[i])] = values[i];
     queries += count;
   }

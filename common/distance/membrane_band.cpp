@@ -13,6 +13,7 @@
 
 #include "distance/eikonal_march.hpp"
 #include "distance/redistance_domain.hpp"
+#include "distance/voxel_winding.hpp"
 
 namespace levelset {
 
@@ -111,18 +112,15 @@ struct FarBrick {
   // (winding_numbers: the values of one query each).
   void prefetch(std::span<const int> voxels) {
     std::array<int, kBrickVoxels> wanted;
-    std::array<Vec3d, kBrickVoxels> points;
     std::size_t count = 0;
     for (const int n : voxels) {
       if (known.test(n)) continue;
       known.set(n);
-      const Coord g = origin + local_coord(n);
-      wanted[count] = n;
-      points[count++] = frame.origin + Vec3d{double(g.x), double(g.y), double(g.z)} * frame.voxel_size;
+      wanted[count++] = n;
     }
     if (count == 0) return;
     std::array<double, kBrickVoxels> values;
-    winding_numbers(tree, std::span(points.data(), count), beta, std::span(values.data(), count));
+    voxel_winding_numbers(tree, frame, origin, std::span(wanted.data(), count), beta, values);
     for (std::size_t i = 0; i < count; ++i) w[std::size_t(wanted[i])] = float(values[i]);
     queries += count;
   }
@@ -376,18 +374,12 @@ class Membranes {
         if (k >= input_count_) {
           std::copy(far_w_[k - input_count_].begin(), far_w_[k - input_count_].end(), wd);
         } else {
-          // One traversal for the brick's membrane voxels (winding_numbers).
-          const Coord o = brick_origin(c);
-          std::array<Vec3d, kBrickVoxels> points;
+          // One traversal for the brick's membrane voxels.
+          std::array<int, kBrickVoxels> voxels;
           std::array<double, kBrickVoxels> values;
           std::size_t count = 0;
-          membrane_[k].for_each_set([&](int n) {
-            const Coord g = o + local_coord(n);
-            points[count++] = o_.frame.origin +
-                              Vec3d{double(g.x), double(g.y), double(g.z)} * o_.frame.voxel_size;
-          });
-          winding_numbers(tree_, std::span(points.data(), count), o_.beta,
-                          std::span(values.data(), count));
+          membrane_[k].for_each_set([&](int n) { voxels[count++] = n; });
+          voxel_winding_numbers(tree_, o_.frame, brick_origin(c), std::span(voxels.data(), count), o_.beta, values);
           count = 0;
           membrane_[k].for_each_set([&](int n) { wd[n] = float(values[count++]); });
           queries[d] += count;
