@@ -10,6 +10,7 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
+#include "apps/nearby_points.hpp"
 #include "core/error.hpp"
 
 namespace levelset::apps {
@@ -204,8 +205,11 @@ double median_of(std::array<double, 8> v, int size) {
   return size % 2 == 1 ? v[std::size_t(size / 2)] : 0.5 * (v[std::size_t(size / 2 - 1)] + v[std::size_t(size / 2)]);
 }
 
-void find_sheet(const PointIndex& index, const Vec3d& x, const Vec3d& n, int k, double min_band, Sheet& s) {
-  s.count = index.k_nearest(x, std::clamp(k, 1, kMaxNeighbors), s.idx.data(), s.d2.data());
+// near: the same k nearest points from a prepared neighbourhood, or null (the tree).
+void find_sheet(const PointIndex& index, const NearbyPoints* nearby, const Vec3d& x, const Vec3d& n, int k,
+                double min_band, Sheet& s) {
+  k = std::clamp(k, 1, kMaxNeighbors);
+  s.count = nearby ? nearby->k_nearest(x, k, s.idx.data(), s.d2.data()) : index.k_nearest(x, k, s.idx.data(), s.d2.data());
   if (s.count == 0) return;
   for (int i = 0; i < s.count; ++i) s.t[std::size_t(i)] = dot(x - index.points()[s.idx[std::size_t(i)]], n);
   const int m = std::min(s.count, 8);
@@ -268,7 +272,7 @@ bool solve_spd(std::array<double, N * N>& M, std::array<double, N>& r, double re
 
 LocalFit one_sided_fit(const PointIndex& index, const Vec3d& x, const Vec3d& n, int k, double min_band) {
   Sheet sh;
-  find_sheet(index, x, n, k, min_band, sh);
+  find_sheet(index, nullptr, x, n, k, min_band, sh);
   return sheet_moments(index, x, sh, sh.count);
 }
 
@@ -357,9 +361,12 @@ HeightFit quadric_height(const TangentPoint* pts, int used) {
 
 }  // namespace
 
-SheetFit sheet_fit(const PointIndex& index, const Vec3d& x, const Vec3d& n, int k, int k_height, double min_band) {
+namespace {
+
+SheetFit sheet_fit_from(const PointIndex& index, const NearbyPoints* near, const Vec3d& x, const Vec3d& n, int k,
+                        int k_height, double min_band) {
   Sheet sh;
-  find_sheet(index, x, n, std::max(k, k_height), min_band, sh);
+  find_sheet(index, near, x, n, std::max(k, k_height), min_band, sh);
   SheetFit f;
   f.plane = sheet_moments(index, x, sh, k);
   // Height function z(xi, eta) over the tangent plane of n at x.
@@ -388,6 +395,16 @@ SheetFit sheet_fit(const PointIndex& index, const Vec3d& x, const Vec3d& n, int 
   f.height_residual = fit.residual;
   f.has_height = true;
   return f;
+}
+
+}  // namespace
+
+SheetFit sheet_fit(const PointIndex& index, const Vec3d& x, const Vec3d& n, int k, int k_height, double min_band) {
+  return sheet_fit_from(index, nullptr, x, n, k, k_height, min_band);
+}
+
+SheetFit sheet_fit(const NearbyPoints& near, const Vec3d& x, const Vec3d& n, int k, int k_height, double min_band) {
+  return sheet_fit_from(near.index(), &near, x, n, k, k_height, min_band);
 }
 
 PointFitFieldResult point_fit_field(const PointIndex& index, const NarrowBand& where,

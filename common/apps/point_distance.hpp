@@ -136,6 +136,9 @@ struct SheetFit {
   bool has_height = false;
 };
 SheetFit sheet_fit(const PointIndex& index, const Vec3d& x, const Vec3d& n, int k, int k_height, double min_band);
+// The same, its k nearest points from a neighbourhood prepared around x (apps/nearby_points.hpp).
+class NearbyPoints;
+SheetFit sheet_fit(const NearbyPoints& near, const Vec3d& x, const Vec3d& n, int k, int k_height, double min_band);
 
 struct PointFitFieldOptions {
   int neighbors = 8;  // k
