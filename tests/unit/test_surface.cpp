@@ -82,6 +82,44 @@ TEST(MeshMeasuresTest, BowtieVertexIsNonManifold) {
   EXPECT_FALSE(r.manifold);
 }
 
+// measure_mesh counts edges at their lower vertex; a global sort of all directed edges is
+// the plain definition. Random index triples (repeated indices, edges in 1-4 triangles, both
+// directions) must give the same counts.
+TEST(MeshMeasuresTest, EdgeCountsMatchAGlobalSortOnMessyMeshes) {
+  std::mt19937 rng(11);
+  for (int trial = 0; trial < 20; ++trial) {
+    TriangleMesh m;
+    const std::uint32_t nv = 6 + std::uint32_t(trial);
+    for (std::uint32_t v = 0; v < nv; ++v) m.vertices.push_back({double(v), double(v * v % 7), double(v % 3)});
+    std::uniform_int_distribution<std::uint32_t> pick(0, nv - 1);
+    for (int f = 0; f < 40; ++f) m.triangles.push_back({pick(rng), pick(rng), pick(rng)});
+    std::vector<std::array<std::uint32_t, 3>> directed;  // lo, hi, forward
+    for (const auto& t : m.triangles)
+      for (int k = 0; k < 3; ++k) {
+        const std::uint32_t u = t[std::size_t(k)], w = t[std::size_t((k + 1) % 3)];
+        directed.push_back({std::min(u, w), std::max(u, w), u < w ? 1u : 0u});
+      }
+    std::sort(directed.begin(), directed.end());
+    std::uint64_t edges = 0, boundary = 0, non_manifold = 0, misoriented = 0;
+    for (std::size_t i = 0; i < directed.size();) {
+      std::size_t j = i;
+      std::uint32_t fwd = 0;
+      while (j < directed.size() && directed[j][0] == directed[i][0] && directed[j][1] == directed[i][1])
+        fwd += directed[j++][2];
+      ++edges;
+      if (j - i == 1) ++boundary;
+      else if (j - i > 2) ++non_manifold;
+      else if (fwd != 1) ++misoriented;
+      i = j;
+    }
+    const MeshMeasures r = measure_mesh(m);
+    EXPECT_EQ(r.edges, edges) << "trial " << trial;
+    EXPECT_EQ(r.boundary_edges, boundary) << "trial " << trial;
+    EXPECT_EQ(r.non_manifold_edges, non_manifold) << "trial " << trial;
+    EXPECT_EQ(r.misoriented_edges, misoriented) << "trial " << trial;
+  }
+}
+
 struct SphereErrors {
   double mc_area, mc_volume, sn_area, sn_volume;
 };
