@@ -289,6 +289,8 @@ struct HeightFit {
   double offset = 0.0;    // x's signed distance to the quadric (world)
   double residual = 0.0;  // weighted RMS residual, corrected for the 6 coefficients (world)
   double spread = 0.0;    // kWithSpread: standard error of c0 per unit noise, sqrt(y^T (sum w^2 phi phi^T) y), M y = e0
+  std::array<double, 6> c{};  // the quadric over (u, v) = (xi, eta) * inv_r
+  double inv_r = 0.0;
 };
 
 // The weighted least-squares quadric z = c0 + c1 u + ... + c5 v^2 (u, v the tangential
@@ -344,6 +346,8 @@ HeightFit quadric_height(const TangentPoint* pts, int used) {
   const double slope2 = (r[1] * r[1] + r[2] * r[2]) * inv_r * inv_r;
   f.offset = -r[0] / std::sqrt(1.0 + slope2);
   f.spread = std::sqrt(std::max(0.0, var));
+  f.c = r;
+  f.inv_r = inv_r;
   // The quadric's weighted residual: the points' noise, free of the surface's curvature
   // (which the quadric absorbs), corrected for the 6 fitted coefficients.
   double wsum = 0.0, rsum = 0.0;
@@ -364,16 +368,20 @@ HeightFit quadric_height(const TangentPoint* pts, int used) {
 
 namespace {
 
-SheetFit sheet_fit_from(const PointIndex& index, const NearbyPoints* near, const Vec3d& x, const Vec3d& n, int k,
-                        int k_height, double min_band) {
+SheetModel sheet_model_from(const PointIndex& index, const NearbyPoints* near, const Vec3d& x, const Vec3d& n, int k,
+                            int k_height, double min_band) {
   Sheet sh;
   find_sheet(index, near, x, n, std::max(k, k_height), min_band, sh);
-  SheetFit f;
+  SheetModel f;
+  f.x = x;
+  f.n = n;
   f.plane = sheet_moments(index, x, sh, k);
   // Height function z(xi, eta) over the tangent plane of n at x.
   const Vec3d t1 = std::abs(n.x) < 0.6 ? cross(n, Vec3d{1, 0, 0}) : cross(n, Vec3d{0, 1, 0});
   const Vec3d e1 = t1 / length(t1);
   const Vec3d e2 = cross(n, e1);
+  f.e1 = e1;
+  f.e2 = e2;
   std::array<TangentPoint, kMaxNeighbors> pts;  // the first `used` entries are written
   int used = 0;
   for (int i = 0; i < std::min(k_height, sh.count); ++i) {
@@ -389,10 +397,12 @@ SheetFit sheet_fit_from(const PointIndex& index, const NearbyPoints* near, const
   // interval: then the small patch's (unbiased) offset is taken.
   const int small = std::max(kSmallPatch, used / kPatchRatio);
   if (used >= 2 * small) {
-    const HeightFit near = quadric_height<true>(pts.data(), small);
-    if (near.ok && std::abs(fit.offset - near.offset) > kPatchConfidence * near.residual * near.spread) fit = near;
+    const HeightFit small_fit = quadric_height<true>(pts.data(), small);
+    if (small_fit.ok && std::abs(fit.offset - small_fit.offset) > kPatchConfidence * small_fit.residual * small_fit.spread)
+      fit = small_fit;
   }
-  f.height_offset = fit.offset;
+  f.c = fit.c;
+  f.inv_r = fit.inv_r;
   f.height_residual = fit.residual;
   f.has_height = true;
   return f;
@@ -400,12 +410,47 @@ SheetFit sheet_fit_from(const PointIndex& index, const NearbyPoints* near, const
 
 }  // namespace
 
+SheetFit SheetModel::at(const Vec3d& y) const {
+  SheetFit f;
+  f.plane = plane;
+  const Vec3d d = y - x;
+  if (d.x != 0.0 || d.y != 0.0 || d.z != 0.0) {
+    // Moments about y: mean(y - p) = a + d; mean (y - p)(y - p)^T = S + d a^T + a d^T + d d^T.
+    const double ax = plane.ax, ay = plane.ay, az = plane.az;
+    f.plane.ax = float(ax + d.x);
+    f.plane.ay = float(ay + d.y);
+    f.plane.az = float(az + d.z);
+    f.plane.sxx = float(double(plane.sxx) + 2.0 * d.x * ax + d.x * d.x);
+    f.plane.sxy = float(double(plane.sxy) + d.x * ay + ax * d.y + d.x * d.y);
+    f.plane.sxz = float(double(plane.sxz) + d.x * az + ax * d.z + d.x * d.z);
+    f.plane.syy = float(double(plane.syy) + 2.0 * d.y * ay + d.y * d.y);
+    f.plane.syz = float(double(plane.syz) + d.y * az + ay * d.z + d.y * d.z);
+    f.plane.szz = float(double(plane.szz) + 2.0 * d.z * az + d.z * d.z);
+  }
+  if (!has_height) return f;
+  // y's foot on the tangent plane (u, v) and its height zeta over x; the quadric relative to
+  // y is z - zeta, so y's offset is -(z(u, v) - zeta) times the cosine of the slope there.
+  const double u = dot(d, e1) * inv_r, v = dot(d, e2) * inv_r, zeta = dot(d, n);
+  const double z = c[0] + c[1] * u + c[2] * v + c[3] * u * u + c[4] * u * v + c[5] * v * v;
+  const double zu = c[1] + 2.0 * c[3] * u + c[4] * v, zv = c[2] + c[4] * u + 2.0 * c[5] * v;
+  const double slope2 = (zu * zu + zv * zv) * inv_r * inv_r;
+  f.height_offset = -(z - zeta) / std::sqrt(1.0 + slope2);
+  f.height_residual = height_residual;
+  f.has_height = true;
+  return f;
+}
+
 SheetFit sheet_fit(const PointIndex& index, const Vec3d& x, const Vec3d& n, int k, int k_height, double min_band) {
-  return sheet_fit_from(index, nullptr, x, n, k, k_height, min_band);
+  return sheet_model_from(index, nullptr, x, n, k, k_height, min_band).at(x);
 }
 
 SheetFit sheet_fit(const NearbyPoints& near, const Vec3d& x, const Vec3d& n, int k, int k_height, double min_band) {
-  return sheet_fit_from(near.index(), &near, x, n, k, k_height, min_band);
+  return sheet_model_from(near.index(), &near, x, n, k, k_height, min_band).at(x);
+}
+
+SheetModel sheet_model(const NearbyPoints& near, const Vec3d& x, const Vec3d& n, int k, int k_height,
+                       double min_band) {
+  return sheet_model_from(near.index(), &near, x, n, k, k_height, min_band);
 }
 
 PointFitFieldResult point_fit_field(const PointIndex& index, const NarrowBand& where,

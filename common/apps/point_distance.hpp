@@ -29,6 +29,7 @@
 #pragma once
 
 #include <algorithm>
+#include <array>
 #include <cstdint>
 #include <memory>
 #include <span>
@@ -139,6 +140,25 @@ SheetFit sheet_fit(const PointIndex& index, const Vec3d& x, const Vec3d& n, int 
 // The same, its k nearest points from a neighbourhood prepared around x (apps/nearby_points.hpp).
 class NearbyPoints;
 SheetFit sheet_fit(const NearbyPoints& near, const Vec3d& x, const Vec3d& n, int k, int k_height, double min_band);
+
+// A sheet fit made once at x and evaluated at positions y near it (the voxels of a small block
+// can share one fit). at(y): the plane fit's moments moved to y (a and S are moments about the
+// evaluation point, moved exactly; LocalFit::d stays x's) and y's signed distance to the
+// fitted quadric (-(z(u, v) - zeta) / sqrt(1 + |grad z|^2) at y's foot (u, v) on the tangent
+// plane, zeta its height over x); at(x) equals sheet_fit at x bit for bit. The evaluation is
+// as good as the quadric is away from the patch's centre: keep |y - x| well inside
+// patch_radius().
+struct SheetModel {
+  Vec3d x{}, n{}, e1{}, e2{};
+  LocalFit plane;
+  bool has_height = false;
+  std::array<double, 6> c{};  // z = c0 + c1 u + c2 v + c3 u^2 + c4 u v + c5 v^2, (u, v) = (xi, eta) * inv_r
+  double inv_r = 0.0;
+  double height_residual = 0.0;
+  double patch_radius() const { return inv_r > 0.0 ? 1.0 / inv_r : 0.0; }
+  SheetFit at(const Vec3d& y) const;
+};
+SheetModel sheet_model(const NearbyPoints& near, const Vec3d& x, const Vec3d& n, int k, int k_height, double min_band);
 
 struct PointFitFieldOptions {
   int neighbors = 8;  // k

@@ -52,7 +52,9 @@
 //   outside by simple flips only, so no handle is made; then at least 3 snap passes: homer's
 //   legs at 50k points, bench_reconstruct --sweep); then snap_passes times: every voxel within 1 voxel of the front computes its front offset
 //   e = clamp(s - u, -h, h) from fits of the points near the voxel (the others within 1.5
-//   voxels, which also move, take their neighbours' mean e) (point_distance.hpp
+//   voxels, which also move, take their neighbours' mean e; the voxels of a column along the
+//   normal share one fit, made at their centroid and evaluated at each, where its quadric
+//   patch is at least 4 voxels wide: SheetModel) (point_distance.hpp
 //   sheet_fit: the nearest points less those off the near sheet along the normal, so a part
 //   thinner than the neighbourhood is not flattened onto its middle plane), two of them:
 //   the plane (centroid) fit of the k nearest, with the curvature correction from the coarse

@@ -153,6 +153,7 @@ LevelOutput flow_level(NarrowBand band, const PointIndex& index, const Reconstru
   // Cache of fits: the voxels within W + 2 of the start front.
   RedistanceOptions grow;
   grow.half_width = W + 2.0;
+  grow.order = 1;  // only its voxel set is used (where fits are cached): the cheaper update
   grow.progress = o.progress;
   const NarrowBand cache = redistance(band, grow).band;
   PointFitFieldOptions fit_options;

@@ -10,6 +10,7 @@
 #include <random>
 
 #include "apps/mesh_distance.hpp"
+#include "apps/nearby_points.hpp"
 #include "apps/point_distance.hpp"
 #include "apps/point_sampling.hpp"
 #include "apps/reconstruction.hpp"
@@ -79,6 +80,37 @@ TEST(SheetFit, HeightResidualMeasuresNoiseNotCurvature) {
     ++n;
   }
   EXPECT_NEAR(sum / n, sigma, 0.3 * sigma);
+}
+
+// A fit shared by a block of voxels (SheetModel::at): at its own centre it is the sheet fit
+// bit for bit; at positions up to a voxel away (here 0.02 on a sphere of radius 1, sampled
+// densely) its height offset is the signed distance to the sphere within the quadric's
+// truncation (|d|^3 / R^2 terms: ~1e-5), and its plane moments are the moments about that
+// position (the plane offset equals a fit made there from the same points).
+TEST(SheetFit, ModelEvaluatedNearItsCentreIsTheDistance) {
+  const auto sphere = make_sphere({0, 0, 0}, 1.0);
+  SurfaceSampleOptions s;
+  s.count = 200000;
+  s.seed = 3;
+  const PointIndex index(sample_shape_surface(*sphere, s));
+  NearbyPoints near(index);
+  const Vec3d x{0.0, 0.6, 0.8 + 0.004}, n{0.0, 0.6, 0.8};
+  near.prepare(x, 0.05, 64);
+  const SheetModel model = sheet_model(near, x, n, 64, 64, 0.01);
+  ASSERT_TRUE(model.has_height);
+  const SheetFit own = sheet_fit(index, x, n, 64, 64, 0.01), at = model.at(x);
+  EXPECT_EQ(own.height_offset, at.height_offset);
+  EXPECT_EQ(own.plane.signed_offset(n, 0.0, 0.0), at.plane.signed_offset(n, 0.0, 0.0));
+  for (const Vec3d& d : {Vec3d{0.02, 0, 0}, Vec3d{0, -0.015, 0.01}, Vec3d{-0.01, 0.01, -0.012}}) {
+    const Vec3d y = x + d;
+    const double truth = length(y) - 1.0;
+    EXPECT_NEAR(model.at(y).height_offset, truth, 2e-5) << d.x << " " << d.y << " " << d.z;
+    // The plane moments about y: a = mean (y - p) is the centroid's offset from y.
+    const LocalFit moved = model.at(y).plane, there = model.at(x).plane;
+    EXPECT_NEAR(double(moved.ax) - double(there.ax), d.x, 1e-6);
+    EXPECT_NEAR(double(moved.az) - double(there.az), d.z, 1e-6);
+    EXPECT_NEAR(double(moved.sxx), double(there.sxx) + 2 * d.x * double(there.ax) + d.x * d.x, 1e-9);
+  }
 }
 
 TEST(Reconstruction, ResolutionAndLevelsFollowTheData) {
