@@ -303,41 +303,47 @@ HeightFit quadric_height(const TangentPoint* pts, int used) {
   for (int i = 0; i < used; ++i) r2max = std::max(r2max, pts[i].xi * pts[i].xi + pts[i].eta * pts[i].eta);
   if (!(r2max > 0.0)) return f;
   const double inv_r = 1.0 / std::sqrt(r2max);
-  // Lower triangles, packed (a >= b, row by row); each point's weight kept for the residual.
-  std::array<double, 21> M{}, M2{};
+  // The normal matrix sum w phi_a phi_b has only 15 distinct entries, the weighted moments
+  // sum w u^p v^q (p + q <= 4) of the monomials phi = (1, u, v, u^2, uv, v^2); each point's
+  // weight is kept for the residual.
+  std::array<double, 15> mom{}, mom2{};  // (p, q) in kMoment order; mom2 with w^2
   std::array<double, 6> r{};
   std::array<double, kMaxNeighbors> weight;
   for (int i = 0; i < used; ++i) {
     const double u = pts[i].xi * inv_r, v = pts[i].eta * inv_r;
     const double w = std::exp(-(u * u + v * v));
     weight[std::size_t(i)] = w;
-    const double phi[6] = {1.0, u, v, u * u, u * v, v * v};
-    int k = 0;
-    for (int a = 0; a < 6; ++a) {
-      const double wa = w * phi[a];
-      r[std::size_t(a)] += wa * pts[i].z;
-      for (int b = 0; b <= a; ++b, ++k) M[std::size_t(k)] += wa * phi[b];
-      if constexpr (kWithSpread) {
-        const double w2a = w * w * phi[a];
-        for (int b = 0, k2 = k - a - 1; b <= a; ++b, ++k2) M2[std::size_t(k2)] += w2a * phi[b];
-      }
-    }
+    const double uu = u * u, uv = u * v, vv = v * v;
+    const double m[15] = {1.0, u, v, uu, uv, vv, uu * u, uu * v, u * vv, vv * v, uu * uu, uu * uv, uu * vv, uv * vv, vv * vv};
+    for (int k = 0; k < 15; ++k) mom[std::size_t(k)] += w * m[k];
+    if constexpr (kWithSpread)
+      for (int k = 0; k < 15; ++k) mom2[std::size_t(k)] += w * w * m[k];
+    const double wz = w * pts[i].z;
+    r[0] += wz;
+    r[1] += wz * u;
+    r[2] += wz * v;
+    r[3] += wz * uu;
+    r[4] += wz * uv;
+    r[5] += wz * vv;
   }
-  auto full = [](const std::array<double, 21>& packed) {
+  // The moment index of phi_a phi_b: monomial exponents added.
+  auto full = [](const std::array<double, 15>& moments) {
+    static constexpr int kP[6] = {0, 1, 0, 2, 1, 0}, kQ[6] = {0, 0, 1, 0, 1, 2};
+    // Index of u^p v^q in the moment list, by degree then by decreasing p.
+    auto index = [](int p, int q) { const int d = p + q; return d * (d + 1) / 2 + q; };
     std::array<double, 36> m{};
-    int k = 0;
     for (int a = 0; a < 6; ++a)
-      for (int b = 0; b <= a; ++b, ++k) m[std::size_t(a * 6 + b)] = m[std::size_t(b * 6 + a)] = packed[std::size_t(k)];
+      for (int b = 0; b < 6; ++b) m[std::size_t(a * 6 + b)] = moments[std::size_t(index(kP[a] + kP[b], kQ[a] + kQ[b]))];
     return m;
   };
-  std::array<double, 36> L = full(M);
+  std::array<double, 36> L = full(mom);
   if (!solve_spd<6>(L, r, kHeightConditioning)) return f;
   double var = 0.0;
   if constexpr (kWithSpread) {
     std::array<double, 6> y{1.0, 0.0, 0.0, 0.0, 0.0, 0.0};
-    L = full(M);
+    L = full(mom);
     solve_spd<6>(L, y, kHeightConditioning);  // factorises as above: succeeds
-    const std::array<double, 36> S = full(M2);
+    const std::array<double, 36> S = full(mom2);
     for (int a = 0; a < 6; ++a)
       for (int b = 0; b < 6; ++b) var += y[std::size_t(a)] * S[std::size_t(a * 6 + b)] * y[std::size_t(b)];
   }
