@@ -8,6 +8,10 @@ namespace levelset::apps {
 
 namespace {
 constexpr int kMaxK = 256;  // PointIndex's own bound on k
+// More candidates than this fall back to the tree: the cost of prepare stays bounded where
+// the k nearest of the centre are far while many points lie just beyond them (a sparse
+// patch next to a dense cluster; typical neighbourhoods hold 3-6 k).
+constexpr std::size_t kCandidatesPerNeighbour = 32, kMinCandidateCap = 2048;
 }
 
 void NearbyPoints::prepare(const Vec3d& centre, double reach, int k) {
@@ -26,8 +30,9 @@ void NearbyPoints::prepare(const Vec3d& centre, double reach, int k) {
   if (got < k_) {
     found_.clear();
     for (std::uint32_t i = 0; i < std::uint32_t(index_->size()); ++i) found_.push_back({i, 0.0});
-  } else {
-    index_->within(centre, radius, found_);
+  } else if (!index_->within(centre, radius, std::max<std::size_t>(kMinCandidateCap, kCandidatesPerNeighbour * std::size_t(k_)),
+                             found_)) {
+    return;  // a neighbourhood this crowded (points far denser than the k nearest suggest): the tree
   }
   const std::vector<Vec3d>& points = index_->points();
   candidates_.reserve(found_.size());

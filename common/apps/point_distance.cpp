@@ -91,6 +91,41 @@ void PointIndex::within(const Vec3d& x, double radius, std::vector<std::pair<std
   tree_->tree.radiusSearch(q, radius * radius, out, nanoflann::SearchParams(32, 0.0f, false));
 }
 
+namespace {
+
+// nanoflann's radius result set, stopping the search once `cap` points were found.
+struct CappedRadiusSet {
+  double radius2;
+  std::size_t cap;
+  std::vector<std::pair<std::uint32_t, double>>& out;
+  bool overflow = false;
+  void init() { out.clear(); }
+  void clear() { out.clear(); }
+  std::size_t size() const { return out.size(); }
+  bool full() const { return true; }
+  double worstDist() const { return radius2; }
+  bool addPoint(double d2, std::uint32_t index) {
+    if (!(d2 < radius2)) return true;
+    if (out.size() >= cap) {
+      overflow = true;
+      return false;
+    }
+    out.emplace_back(index, d2);
+    return true;
+  }
+};
+
+}  // namespace
+
+bool PointIndex::within(const Vec3d& x, double radius, std::size_t cap,
+                        std::vector<std::pair<std::uint32_t, double>>& out) const {
+  out.clear();
+  const double q[3] = {x.x, x.y, x.z};
+  CappedRadiusSet set{radius * radius, cap, out};
+  tree_->tree.radiusSearchCustomCallback(q, set, nanoflann::SearchParams(32, 0.0f, false));
+  return !set.overflow;
+}
+
 double sample_gap(const PointIndex& index, int k, double quantile, std::size_t samples) {
   const std::size_t n = index.size();
   if (n < 2 || samples == 0) return 0.0;

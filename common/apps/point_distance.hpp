@@ -61,6 +61,8 @@ class PointIndex {
   int k_nearest(const Vec3d& x, int k, std::uint32_t* indices, double* distances_squared) const;
   // All points within `radius` of x (index, squared distance), unordered; `out` is cleared.
   void within(const Vec3d& x, double radius, std::vector<std::pair<std::uint32_t, double>>& out) const;
+  // The same, stopping after `cap` points: false (and `out` incomplete) when there are more.
+  bool within(const Vec3d& x, double radius, std::size_t cap, std::vector<std::pair<std::uint32_t, double>>& out) const;
 
  private:
   struct Tree;

@@ -86,6 +86,24 @@ TEST(NearbyPoints, SmallSetsAndFallbacks) {
   for (int i = 0; i < na; ++i) EXPECT_EQ(da[std::size_t(i)], db[std::size_t(i)]);
 }
 
+// A sparse patch next to a dense cluster: the centre's k nearest are far, so the candidate
+// ball would hold the whole cluster; prepare gives up past its cap and the answers (from the
+// tree) are still exact. PointIndex::within with a cap reports the overflow.
+TEST(NearbyPoints, CrowdedNeighbourhoodFallsBackToTheTree) {
+  std::vector<Vec3d> p;
+  for (int i = 0; i < 8; ++i) p.push_back({double(i) * 0.1, 0.0, 0.0});
+  std::mt19937_64 rng(12);
+  std::uniform_real_distribution<double> u(0.0, 0.05);
+  for (int i = 0; i < 100000; ++i) p.push_back({2.0 + u(rng), u(rng), u(rng)});
+  const PointIndex index(p);
+  std::vector<std::pair<std::uint32_t, double>> found;
+  EXPECT_FALSE(index.within({2.0, 0.0, 0.0}, 1.0, 500, found));
+  EXPECT_EQ(found.size(), 500u);
+  EXPECT_TRUE(index.within({0.0, 0.0, 0.0}, 0.25, 500, found));
+  EXPECT_EQ(found.size(), 3u);  // 0, 0.1 and 0.2
+  expect_same_as_tree(index, {0.3, 0.0, 0.0}, 0.1, 46, 13);
+}
+
 TEST(NearbyPoints, SheetFitIsTheSame) {
   const PointIndex index(wavy_sheet(20000, 9));
   NearbyPoints near(index);
