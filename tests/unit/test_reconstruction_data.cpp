@@ -57,20 +57,24 @@ TEST(SamplingEstimate, NoiseIsTheSpreadNormalToTheSurface) {
   EXPECT_THROW(estimate_sampling(three), Error);
 }
 
+// 200k points on the unit sphere, Gaussian noise sigma along the normal.
+std::vector<Vec3d> unit_sphere_points(unsigned seed, double sigma) {
+  SurfaceSampleOptions s;
+  s.count = 200000;
+  s.seed = seed;
+  s.noise = sigma;
+  return sample_shape_surface(*make_sphere({0, 0, 0}, 1.0), s);
+}
+
 TEST(SheetFit, HeightResidualMeasuresNoiseNotCurvature) {
   // A sphere of radius 1: the plane fit's spread carries the patch's sagitta, the quadric's
   // residual does not.
-  const auto sphere = make_sphere({0, 0, 0}, 1.0);
-  SurfaceSampleOptions s;
-  s.count = 200000;
-  s.seed = 2;
-  const PointIndex clean(sample_shape_surface(*sphere, s));
+  const PointIndex clean(unit_sphere_points(2, 0.0));
   const SheetFit c = sheet_fit(clean, {0, 0, 1}, {0, 0, 1}, 8, 64, 0.01);
   ASSERT_TRUE(c.has_height);
   EXPECT_LT(c.height_residual, 2e-4);
   const double sigma = 0.002;
-  s.noise = sigma;
-  const PointIndex noisy(sample_shape_surface(*sphere, s));
+  const PointIndex noisy(unit_sphere_points(2, sigma));
   double sum = 0;
   int n = 0;
   for (const Vec3d& d : {Vec3d{0, 0, 1}, Vec3d{1, 0, 0}, Vec3d{0, -1, 0}, Vec3d{0.6, 0.8, 0}}) {
@@ -88,11 +92,7 @@ TEST(SheetFit, HeightResidualMeasuresNoiseNotCurvature) {
 // truncation (|d|^3 / R^2 terms: ~1e-5), and its plane moments are the moments about that
 // position (the plane offset equals a fit made there from the same points).
 TEST(SheetFit, ModelEvaluatedNearItsCentreIsTheDistance) {
-  const auto sphere = make_sphere({0, 0, 0}, 1.0);
-  SurfaceSampleOptions s;
-  s.count = 200000;
-  s.seed = 3;
-  const PointIndex index(sample_shape_surface(*sphere, s));
+  const PointIndex index(unit_sphere_points(3, 0.0));
   NearbyPoints near(index);
   const Vec3d x{0.0, 0.6, 0.8 + 0.004}, n{0.0, 0.6, 0.8};
   near.prepare(x, 0.05, 64);
