@@ -99,7 +99,6 @@ struct CappedRadiusSet {
   std::size_t cap;
   std::vector<std::pair<std::uint32_t, double>>& out;
   bool overflow = false;
-  void init() { out.clear(); }
   void clear() { out.clear(); }
   std::size_t size() const { return out.size(); }
   bool full() const { return true; }

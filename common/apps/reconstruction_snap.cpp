@@ -1,6 +1,7 @@
 // reconstruct_surface's finer levels: the snap of the front onto the points' local fits
 // (reconstruction_parts.hpp).
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <cmath>
 #include <cstdint>
@@ -188,8 +189,8 @@ int noisy_height_neighbors(const NarrowBand& band, std::size_t points, double h_
 }
 
 // The k nearest points of every voxel of brick b with |u| < window from one radius query
-// (apps/nearby_points.hpp; identical results): around the box of those voxels. Final-level
-// fits of a 20k-point reconstruction (k = 46): see the commit measuring it.
+// (apps/nearby_points.hpp; identical results): around the box of those voxels (bunny, 20k
+// points, 0.1 %: the final level's fits, k = 46, 1.67 -> 1.37 s).
 void prepare_brick_neighbours(const NarrowBand& band, std::uint32_t b, double window, int k, NearbyPoints& near) {
   Coord lo{kBrickDim, kBrickDim, kBrickDim}, hi{-1, -1, -1};
   const Coord origin = brick_origin(band.bricks()[b].coord);
@@ -242,7 +243,7 @@ void fit_voxels(const NearbyPoints& near, const std::vector<FitVoxel>& voxels, c
   for (int k = 0; k < kColumns; ++k) first[std::size_t(k + 1)] += first[std::size_t(k)];
   std::array<int, kColumns> fill{};
   std::copy(first.begin(), first.begin() + kColumns, fill.begin());
-  std::vector<int> by_column(voxels.size());
+  std::array<int, kBrickVoxels> by_column;  // voxel indices grouped by column (a brick has at most 512)
   for (std::size_t v = 0; v < voxels.size(); ++v) by_column[std::size_t(fill[std::size_t(voxels[v].column)]++)] = int(v);
   auto own = [&](int v) {
     fits[std::size_t(v)] = sheet_fit(near, voxels[std::size_t(v)].x, voxels[std::size_t(v)].n, fs.neighbors,
