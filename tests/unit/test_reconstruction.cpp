@@ -2,11 +2,14 @@
 // samples, accuracy against the exact surfaces, topology, noise, bad inputs.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <limits>
 #include <numbers>
 #include <random>
+
+#include <tbb/task_arena.h>
 
 #include "apps/mesh_distance.hpp"
 #include "apps/point_distance.hpp"
@@ -269,6 +272,26 @@ TEST(Reconstruction, NoisySphereStaysWithinTheNoise) {
   // Averaging 16 points divides the noise by 4: well under the noise's own mean |e| (0.4 voxel).
   EXPECT_LT(d.chamfer, 0.25) << d.chamfer;
   EXPECT_FALSE(r.stages.back().second_order);  // noise: the plane fits, averaged
+}
+
+// The result does not depend on the thread count (the header's promise): per-brick fits with
+// shared neighbourhoods and column fits, per-brick sums added in brick order. Sparse noisy
+// points, so the final level's fits are shared.
+TEST(Reconstruction, SameResultForAnyThreadCount) {
+  const auto sphere = make_sphere({0, 0, 0}, 1.0);
+  ReconstructionOptions o;
+  o.resolution = 128;  // three levels: the last takes the density-sized height fits
+  const double h = 2.0 / (128 - 2 * (3 + 2));
+  const std::vector<Vec3d> points = samples(*sphere, 5000, 1.0 * h, 5);
+  ReconstructionResult one, two;
+  tbb::task_arena(1).execute([&] { one = reconstruct_surface(points, o); });
+  tbb::task_arena(2).execute([&] { two = reconstruct_surface(points, o); });
+  // 48 points at ~0.12 per voxel^2: patches ~11 voxels wide, so the column fits are shared.
+  EXPECT_GE(one.stages.back().height_neighbors, 32);
+  ASSERT_EQ(one.band.active_voxel_count(), two.band.active_voxel_count());
+  ASSERT_TRUE(std::equal(one.band.values().begin(), one.band.values().end(), two.band.values().begin()));
+  ASSERT_EQ(one.mesh.vertices.size(), two.mesh.vertices.size());
+  EXPECT_TRUE(std::equal(one.mesh.vertices.begin(), one.mesh.vertices.end(), two.mesh.vertices.begin()));
 }
 
 // The band invariant after the snaps: every voxel within W h of the final front is active
