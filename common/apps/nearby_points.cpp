@@ -12,7 +12,7 @@ constexpr int kMaxK = 256;  // PointIndex's own bound on k
 // the k nearest of the centre are far while many points lie just beyond them (a sparse
 // patch next to a dense cluster; typical neighbourhoods hold 3-6 k).
 constexpr std::size_t kCandidatesPerNeighbour = 32, kMinCandidateCap = 2048;
-}
+}  // namespace
 
 void NearbyPoints::prepare(const Vec3d& centre, double reach, int k) {
   centre_ = centre;
@@ -30,9 +30,12 @@ void NearbyPoints::prepare(const Vec3d& centre, double reach, int k) {
   if (got < k_) {
     found_.clear();
     for (std::uint32_t i = 0; i < std::uint32_t(index_->size()); ++i) found_.push_back({i, 0.0});
-  } else if (!index_->within(centre, radius, std::max<std::size_t>(kMinCandidateCap, kCandidatesPerNeighbour * std::size_t(k_)),
-                             found_)) {
-    return;  // a neighbourhood this crowded (points far denser than the k nearest suggest): the tree
+  } else if (!index_->within(
+                 centre, radius,
+                 std::max<std::size_t>(kMinCandidateCap, kCandidatesPerNeighbour * std::size_t(k_)),
+                 found_)) {
+    return;  // a neighbourhood this crowded (points far denser than the k nearest suggest): the
+             // tree
   }
   const std::vector<Vec3d>& points = index_->points();
   candidates_.reserve(found_.size());
@@ -41,14 +44,17 @@ void NearbyPoints::prepare(const Vec3d& centre, double reach, int k) {
     candidates_.push_back({length(p - centre), p.x, p.y, p.z, i});
   }
   std::sort(candidates_.begin(), candidates_.end(), [](const Candidate& a, const Candidate& b) {
-    return a.centre_distance < b.centre_distance || (a.centre_distance == b.centre_distance && a.index < b.index);
+    return a.centre_distance < b.centre_distance ||
+           (a.centre_distance == b.centre_distance && a.index < b.index);
   });
   reach_ = reach;
 }
 
-int NearbyPoints::k_nearest(const Vec3d& x, int k, std::uint32_t* indices, double* distances_squared) const {
+int NearbyPoints::k_nearest(const Vec3d& x, int k, std::uint32_t* indices,
+                            double* distances_squared) const {
   const double offset = length(x - centre_);
-  if (!(reach_ >= 0.0) || k > k_ || !(offset <= reach_)) return index_->k_nearest(x, k, indices, distances_squared);
+  if (!(reach_ >= 0.0) || k > k_ || !(offset <= reach_))
+    return index_->k_nearest(x, k, indices, distances_squared);
   if (k <= 0) return 0;
   // The running k best, sorted by (distance, index), as the tree's result set keeps them.
   int count = 0;
@@ -68,7 +74,8 @@ int NearbyPoints::k_nearest(const Vec3d& x, int k, std::uint32_t* indices, doubl
                         (d == distances_squared[k - 1] && c.index < indices[k - 1])))
       continue;
     int at = count < k ? count++ : k - 1;
-    while (at > 0 && (distances_squared[at - 1] > d || (distances_squared[at - 1] == d && indices[at - 1] > c.index))) {
+    while (at > 0 && (distances_squared[at - 1] > d ||
+                      (distances_squared[at - 1] == d && indices[at - 1] > c.index))) {
       distances_squared[at] = distances_squared[at - 1];
       indices[at] = indices[at - 1];
       --at;

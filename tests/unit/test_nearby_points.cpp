@@ -31,14 +31,16 @@ std::vector<Vec3d> wavy_sheet(std::size_t n, unsigned seed) {
 // Compares NearbyPoints against the tree at `queries` random positions within `reach` of
 // `centre` (and the box's corners); the distances must agree exactly, and the index sets too
 // (up to equidistant points, which here are duplicates at the same position).
-void expect_same_as_tree(const PointIndex& index, const Vec3d& centre, double reach, int k, unsigned seed) {
+void expect_same_as_tree(const PointIndex& index, const Vec3d& centre, double reach, int k,
+                         unsigned seed) {
   NearbyPoints near(index);
   near.prepare(centre, reach, k);
   std::mt19937_64 rng(seed);
   std::uniform_real_distribution<double> u(-1, 1);
   std::vector<Vec3d> queries;
   const double c = reach / std::sqrt(3.0);
-  for (int i = 0; i < 8; ++i) queries.push_back(centre + Vec3d{(i & 1) ? c : -c, (i & 2) ? c : -c, (i & 4) ? c : -c});
+  for (int i = 0; i < 8; ++i)
+    queries.push_back(centre + Vec3d{(i & 1) ? c : -c, (i & 2) ? c : -c, (i & 4) ? c : -c});
   while (queries.size() < 300) {
     const Vec3d d{u(rng), u(rng), u(rng)};
     if (length(d) <= 1.0) queries.push_back(centre + d * reach);
@@ -52,7 +54,8 @@ void expect_same_as_tree(const PointIndex& index, const Vec3d& centre, double re
       ASSERT_EQ(na, nb);
       for (int i = 0; i < na; ++i) {
         ASSERT_EQ(da[std::size_t(i)], db[std::size_t(i)]) << "rank " << i;
-        ASSERT_EQ(index.points()[ia[std::size_t(i)]], index.points()[ib[std::size_t(i)]]) << "rank " << i;
+        ASSERT_EQ(index.points()[ia[std::size_t(i)]], index.points()[ib[std::size_t(i)]])
+            << "rank " << i;
       }
     }
   }
@@ -61,9 +64,9 @@ void expect_same_as_tree(const PointIndex& index, const Vec3d& centre, double re
 TEST(NearbyPoints, EqualsTheTreeWithinTheReach) {
   const PointIndex index(wavy_sheet(20000, 1));
   expect_same_as_tree(index, {0.1, -0.2, 0.0}, 0.05, 46, 2);
-  expect_same_as_tree(index, {0.9, 0.95, 0.02}, 0.08, 16, 3);   // at the set's edge
-  expect_same_as_tree(index, {0.0, 0.0, 0.3}, 0.02, 32, 4);     // off the sheet
-  expect_same_as_tree(index, {-0.5, 0.5, 0.0}, 0.0, 8, 5);      // a single position
+  expect_same_as_tree(index, {0.9, 0.95, 0.02}, 0.08, 16, 3);  // at the set's edge
+  expect_same_as_tree(index, {0.0, 0.0, 0.3}, 0.02, 32, 4);    // off the sheet
+  expect_same_as_tree(index, {-0.5, 0.5, 0.0}, 0.0, 8, 5);     // a single position
 }
 
 TEST(NearbyPoints, SmallSetsAndFallbacks) {
