@@ -5,8 +5,10 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <memory>
 #include <string>
 
+#include "apps/point_extent.hpp"
 #include "apps/point_sampling.hpp"
 #include "apps/reconstruction_parts.hpp"
 #include "core/error.hpp"
@@ -112,16 +114,34 @@ ReconstructionResult reconstruct_surface(const std::vector<Vec3d>& input, const 
   validate(input, o);
   BBox box;
   for (const Vec3d& p : input) box.extend(p);
-  const Vec3d centre = box.center();
-  const Vec3d ext = box.extent();
-  const double longest = std::max({ext.x, ext.y, ext.z});
-  require(longest > 0.0 && std::isfinite(longest), "all points are equal (or the extent is not finite)");
+  Vec3d centre = box.center();
+  {
+    const Vec3d raw = box.extent();
+    const double longest_raw = std::max({raw.x, raw.y, raw.z});
+    require(longest_raw > 0.0 && std::isfinite(longest_raw), "all points are equal (or the extent is not finite)");
+  }
   const double W = o.half_width;
   std::vector<Vec3d> points(input.size());
   for (std::size_t i = 0; i < input.size(); ++i) points[i] = input[i] - centre;
-  const PointIndex index(points);
+  auto index = std::make_unique<PointIndex>(points);
+  // The grid spans the cloud without its isolated points (far outliers of a scan), which
+  // stay in the index but lie outside every grid; re-centred on that box.
+  const PointExtentResult extent = point_extent(*index);
+  std::uint64_t isolated = 0;
+  if (extent.isolated > 0) {
+    isolated = extent.isolated;
+    box.min = extent.box.min + centre;
+    box.max = extent.box.max + centre;
+    centre = box.center();
+    for (std::size_t i = 0; i < input.size(); ++i) points[i] = input[i] - centre;
+    index = std::make_unique<PointIndex>(points);
+  }
+  const Vec3d ext = box.extent();
+  const double longest = std::max({ext.x, ext.y, ext.z});
+  require(longest > 0.0 && std::isfinite(longest), "all points but isolated ones are equal");
   ReconstructionResult result;
-  result.sampling = estimate_sampling(index, {16, 2000, o.progress});
+  result.isolated_points = isolated;
+  result.sampling = estimate_sampling(*index, {16, 2000, o.progress});
   result.resolution = o.resolution > 0 ? o.resolution : 0;
   if (o.resolution == 0 && o.voxel_size <= 0.0) result.resolution = auto_resolution(result.sampling, longest, W);
   const double h_final = o.voxel_size > 0.0 ? o.voxel_size : longest / (double(result.resolution) - 2.0 * (W + 2.0));
@@ -134,6 +154,7 @@ ReconstructionResult reconstruct_surface(const std::vector<Vec3d>& input, const 
     if (o.log) o.log(line);
   };
 
+  if (isolated > 0) log(std::to_string(isolated) + " isolated points outside the box the grids span");
   if (o.resolution == 0 && o.voxel_size <= 0.0) {
     char chosen[200];
     std::snprintf(chosen, sizeof chosen, "resolution %d from the data: spacing %.4g, noise %.4g (world; %.2f and %.2f voxels)",
@@ -148,7 +169,7 @@ ReconstructionResult reconstruct_surface(const std::vector<Vec3d>& input, const 
   // The start shell closes holes between samples up to its offset: at least kGapClosing times
   // the 90th percentile of the distance to the 8th nearest sample, or its flood fill leaks
   // into the inside and the flow collapses onto the points from both sides.
-  const double gap = sample_gap(index, 8, 0.9, 4000);
+  const double gap = sample_gap(*index, 8, 0.9, 4000);
   // Levels from the data unless given: the coarsest voxel no wider than the gap the shell
   // must close (coarser levels only close more: tunnels and gaps between nearby parts that
   // the points resolve), within [kMinAutoLevels, kMaxAutoLevels]; fewer when the coarsest
@@ -175,17 +196,17 @@ ReconstructionResult reconstruct_surface(const std::vector<Vec3d>& input, const 
     stage.voxel_size = h;
     if (level == 0) {
       // The flow from the start shell.
-      band = start_shell(index, local, origin, h, shell_offset, W, o.progress);
+      band = start_shell(*index, local, origin, h, shell_offset, W, o.progress);
       stage.shell_offset = shell_offset;
       stage.seconds_start = seconds_since(t_level);
-      detail::LevelOutput flowed = detail::flow_level(std::move(band), index, o, levels, std::move(stage));
+      detail::LevelOutput flowed = detail::flow_level(std::move(band), *index, o, levels, std::move(stage));
       band = std::move(flowed.band);
       stage = std::move(flowed.stage);
     }
     if (level > 0 || levels == 1) {
       // The snap (on a single level: after the flow, with its own curvature).
       detail::SnapLevel where{level, levels, h_final, {result.sampling.noise, gap}};
-      detail::SnapOutput snapped = detail::snap_level(std::move(band), index, o, where, std::move(stage), noise);
+      detail::SnapOutput snapped = detail::snap_level(std::move(band), *index, o, where, std::move(stage), noise);
       band = std::move(snapped.band);
       stage = std::move(snapped.stage);
       noise = snapped.noise;

@@ -4,7 +4,9 @@
 //
 // Inputs: points (world units, finite, at least 4, not all equal); ReconstructionOptions.
 // Method:
-//   Grid. Points are shifted to their bounding-box centre (all work in float positions stays
+//   Grid. Isolated points (a scan's far outliers: apps/point_extent.hpp) do not count
+//   towards the box; they stay in the point set, outside every grid. Points are shifted to
+//   their bounding-box centre (all work in float positions stays
 //   exact to ~1e-4 voxel), the final voxel size is h = L / (resolution - 2 (W + 2)) (L the
 //   longest side of the points' box: `resolution` voxels span the box padded by W + 2 on each
 //   side) or voxel_size; level l of `levels` uses h * 2^(levels - 1 - l). With neither given,
@@ -180,6 +182,7 @@ struct ReconstructionResult {
   double voxel_size = 0.0;      // final
   int resolution = 0;           // the final grid's (given, or chosen from the data); 0 with voxel_size
   SamplingEstimate sampling;    // the points' spacing and noise (world), measured first
+  std::uint64_t isolated_points = 0;  // isolated points outside the box the grids span (apps/point_extent.hpp)
   double seconds_mesh = 0.0;
   double seconds = 0.0;         // total
 };
