@@ -14,8 +14,8 @@ PointExtentResult point_extent(const PointIndex& index, const PointExtentOptions
   PointExtentResult r;
   for (const Vec3d& p : points) r.box.extend(p);
   const int k = std::clamp(options.neighbors, 1, 255);
-  if (n < std::size_t(k) + 2) return r;
   r.gap = sample_gap(index, k, 0.9, 4000);
+  if (n < std::size_t(k) + 2) return r;
   const double limit = options.factor * r.gap;
   if (!(limit > 0.0)) return r;  // duplicates: no spacing to judge by
   // The k-th nearest other point (the point itself is its own nearest).

@@ -33,7 +33,7 @@ struct PointExtentOptions {
 struct PointExtentResult {
   BBox box;
   std::uint64_t isolated = 0;  // points outside box
-  double gap = 0.0;            // g (world)
+  double gap = 0.0;            // g (world): sample_gap(index, k, 0.9, 4000), also for small clouds
 };
 
 PointExtentResult point_extent(const PointIndex& index, const PointExtentOptions& options = {});

@@ -169,7 +169,7 @@ ReconstructionResult reconstruct_surface(const std::vector<Vec3d>& input, const 
   // The start shell closes holes between samples up to its offset: at least kGapClosing times
   // the 90th percentile of the distance to the 8th nearest sample, or its flood fill leaks
   // into the inside and the flow collapses onto the points from both sides.
-  const double gap = sample_gap(*index, 8, 0.9, 4000);
+  const double gap = extent.gap;  // sample_gap(index, 8, 0.9, 4000), measured by point_extent
   // Levels from the data unless given: the coarsest voxel no wider than the gap the shell
   // must close (coarser levels only close more: tunnels and gaps between nearby parts that
   // the points resolve), within [kMinAutoLevels, kMaxAutoLevels]; fewer when the coarsest
