@@ -108,9 +108,16 @@ bool ambiguous_face_at_centre(std::uint32_t inside, bool centre) {
 // only after one of its 26 neighbours flipped (nothing else changes its test): O(candidates)
 // tests (rounds over all of them were quadratic along a retracting rod). The others keep
 // their old sign at +-eps. Serial (the flips are few, all at the front): deterministic.
-// Returns the number of flips refused.
-std::uint64_t keep_topology(const NarrowBand& before, const NarrowBand& after, std::vector<float>& values, double eps,
-                            const std::function<bool(const Coord&)>& free, const ProgressHook& progress) {
+// Voxels that are not candidates have `after`'s sign in the tests (a voxel inactive in
+// `after` keeps that sign whatever is decided). A candidate with a face neighbour inactive in
+// `after` on its new side cannot keep its old sign without breaking the band invariant there
+// (`after`'s band left it: a component smaller than the band vanished in one step), so its
+// flip is taken (counted in forced).
+struct KeptTopology {
+  std::uint64_t refused = 0, forced = 0;
+};
+KeptTopology keep_topology(const NarrowBand& before, const NarrowBand& after, std::vector<float>& values, double eps,
+                           const std::function<bool(const Coord&)>& free, const ProgressHook& progress) {
   struct Candidate {
     Coord c;
     std::size_t slot;
@@ -122,8 +129,19 @@ std::uint64_t keep_topology(const NarrowBand& before, const NarrowBand& after, s
   });
   std::vector<Candidate> pending;
   for (const auto& list : per_brick) pending.insert(pending.end(), list.begin(), list.end());
-  if (pending.empty()) return 0;
-  BandAccessor old_acc(before);
+  KeptTopology kept;
+  if (pending.empty()) return kept;
+  BandAccessor old_acc(before), new_acc(after);
+  // must_flip[k]: a face neighbour inactive in `after` lies on the candidate's new side.
+  std::vector<std::uint8_t> must_flip(pending.size(), 0);
+  static constexpr Coord kFaces[6] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
+  for (std::size_t k = 0; k < pending.size(); ++k) {
+    const bool to_inside = values[pending[k].slot] < 0.0f;
+    for (const Coord& f : kFaces) {
+      const Coord n = pending[k].c + f;
+      if (!new_acc.probe(n) && new_acc.is_inside(n) == to_inside) must_flip[k] = 1;
+    }
+  }
   auto key = [](const Coord& c) {
     return (std::uint64_t(std::uint32_t(c.x) & 0x1fffffu) << 42) | (std::uint64_t(std::uint32_t(c.y) & 0x1fffffu) << 21) |
            std::uint64_t(std::uint32_t(c.z) & 0x1fffffu);
@@ -134,8 +152,8 @@ std::uint64_t keep_topology(const NarrowBand& before, const NarrowBand& after, s
   std::vector<std::uint8_t> flipped(pending.size(), 0), queued(pending.size(), 1);
   auto inside_now = [&](const Coord& c) {
     const auto it = candidate_at.find(key(c));
-    if (it != candidate_at.end() && flipped[it->second]) return values[pending[it->second].slot] < 0.0f;
-    return old_acc.is_inside(c);
+    if (it != candidate_at.end()) return flipped[it->second] ? values[pending[it->second].slot] < 0.0f : old_acc.is_inside(c);
+    return new_acc.is_inside(c);
   };
   std::deque<std::size_t> queue;
   for (std::size_t k = 0; k < pending.size(); ++k) queue.push_back(k);
@@ -155,7 +173,10 @@ std::uint64_t keep_topology(const NarrowBand& before, const NarrowBand& after, s
     const bool to_inside = values[cand.slot] < 0.0f;
     const bool keeps = simple_voxel(inside) && !ambiguous_face_at_centre(inside, !to_inside) &&
                        !ambiguous_face_at_centre(inside, to_inside);
-    if (!keeps && !(free && free(cand.c))) continue;
+    if (!keeps && !(free && free(cand.c))) {
+      if (!must_flip[k]) continue;
+      ++kept.forced;
+    }
     flipped[k] = 1;
     for (int dz = -1; dz <= 1; ++dz)
       for (int dy = -1; dy <= 1; ++dy)
@@ -166,13 +187,12 @@ std::uint64_t keep_topology(const NarrowBand& before, const NarrowBand& after, s
           queue.push_back(it->second);
         }
   }
-  std::uint64_t refused = 0;
   for (std::size_t k = 0; k < pending.size(); ++k)
     if (!flipped[k]) {
       values[pending[k].slot] = float(old_acc.is_inside(pending[k].c) ? -eps : eps);
-      ++refused;
+      ++kept.refused;
     }
-  return refused;
+  return kept;
 }
 
 // The marching cubes join or separate the two inside corners of an ambiguous face (signs
@@ -281,7 +301,9 @@ TopologyGuardResult guard_topology(const NarrowBand& before, const NarrowBand& a
   TopologyGuardResult r;
   if (!(options.eps > 0.0) || !std::isfinite(options.eps))
     throw Error(ErrorCode::InvalidArgument, "guard_topology", "eps must be a positive number (a refused flip's |value|)");
-  r.refused_flips = keep_topology(before, after, values, options.eps, options.free, options.progress);
+  const KeptTopology kept = keep_topology(before, after, values, options.eps, options.free, options.progress);
+  r.refused_flips = kept.refused;
+  r.forced_flips = kept.forced;
   r.restored_values = keep_face_decisions(before, after, values);
   r.values = std::move(values);
   return r;

@@ -14,7 +14,12 @@
 //      (6, 26) and may neither make nor unmake an ambiguous face at the voxel. Flips are taken
 //      one by one in brick order, a refused one again after a neighbour flipped; the others keep their old
 //      sign at +-eps. options.free(c), when given and true, allows any flip at voxel c (where
-//      the caller wants topology to change, e.g. far from data).
+//      the caller wants topology to change, e.g. far from data). A flip whose voxel has a face
+//      neighbour inactive in `after` on its new side is taken whatever its test says: keeping
+//      the old sign there would break the band invariant (two face neighbours of opposite sign,
+//      one inactive), which `after`'s band upkeep leaves when a component smaller than the band
+//      vanishes in one step. Counted in forced_flips. Voxels inactive in `after` keep `after`'s
+//      sign (they hold no value to restore), and the tests see it.
 //   2. An ambiguous face (signs alternating round it) with the same four signs before and
 //      after keeps its decision (values are taken to be distances: faces are looked for
 //      among the voxels within 1.5 voxels of the zero level): where a change of values alone would join or separate its inside
@@ -52,6 +57,7 @@ struct TopologyGuardOptions {
 struct TopologyGuardResult {
   std::vector<float> values;
   std::uint64_t refused_flips = 0;
+  std::uint64_t forced_flips = 0;  // not simple, taken anyway: `after` has no room for the old sign (rule 1)
   std::uint64_t restored_values = 0;
 };
 

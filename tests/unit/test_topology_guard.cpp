@@ -13,9 +13,10 @@
 namespace levelset {
 namespace {
 
-NarrowBand band_of(const std::function<double(const Vec3d&)>& sdf, double lo, double hi, double h) {
+NarrowBand band_of(const std::function<double(const Vec3d&)>& sdf, double lo, double hi, double h,
+                   double half_width = 3.0) {
   SdfBuildOptions o;
-  o.frame = GridFrame{h, Vec3d{0, 0, 0}, 3.0};
+  o.frame = GridFrame{h, Vec3d{0, 0, 0}, half_width};
   BBox b;
   b.min = {lo, lo, lo};
   b.max = {hi, hi, hi};
@@ -111,6 +112,55 @@ TEST(TopologyGuard, AmbiguousFaceKeepsItsDecision) {
   kept.swap_values(values);
   EXPECT_FLOAT_EQ(*kept.value({1, 0, 0}), 0.2f);
   EXPECT_FLOAT_EQ(*kept.value({0, 1, 0}), 0.2f);
+}
+
+// Face neighbours of opposite sign where one is not active (the band invariant's breaches),
+// over the active voxels' box grown by 2.
+std::size_t invariant_breaches(const NarrowBand& band) {
+  const IndexBox box = band.active_index_bounds();
+  std::size_t breaches = 0;
+  for (int z = box.min.z - 2; z <= box.max.z + 2; ++z)
+    for (int y = box.min.y - 2; y <= box.max.y + 2; ++y)
+      for (int x = box.min.x - 2; x <= box.max.x + 2; ++x) {
+        const Coord c{x, y, z};
+        for (const Coord& n : {Coord{x + 1, y, z}, Coord{x, y + 1, z}, Coord{x, y, z + 1}})
+          if (band.is_inside(c) != band.is_inside(n) && !(band.is_active(c) && band.is_active(n))) ++breaches;
+      }
+  return breaches;
+}
+
+TEST(TopologyGuard, AComponentTheNewBandLeftVanishesWithoutBreakingTheBand) {
+  // An evolve step can remove a component smaller than the band. Here a rod one voxel thick
+  // runs along z beside a sphere: its middle voxel lies inside the sphere's band, its other
+  // voxels just outside it. Keeping the middle voxel inside (the rod's last voxel) would
+  // leave it next to voxels that are inactive and outside in `after`, which no value can
+  // repair: the flip is taken (forced) and the band invariant holds.
+  const double h = 0.1;
+  auto sphere = [](const Vec3d& p) { return length(p) - 1.0015; };
+  auto rod = [](const Vec3d& p) {
+    return length(Vec3d{p.x - 1.3, p.y, std::max(0.0, std::abs(p.z) - 0.25)}) - 0.05;
+  };
+  auto both = [&](const Vec3d& p) { return std::min(sphere(p), rod(p)); };
+  const NarrowBand before = band_of(both, -1.6, 1.6, h);
+  const NarrowBand after = band_of(sphere, -1.6, 1.6, h);
+  ASSERT_EQ(inside_components(before), 2u);
+  ASSERT_TRUE(before.is_inside({13, 0, 2}) && before.is_inside({13, 0, -2}));
+  ASSERT_TRUE(after.is_active({13, 0, 0}));   // 2.985 voxels off the sphere: in its band
+  ASSERT_FALSE(after.is_active({13, 0, 1}));  // 3.02 voxels off: not
+  TopologyGuardOptions o;
+  o.eps = 1e-3 * h;
+  const TopologyGuardResult r = guard_topology(before, after, values_of(after), o);
+  EXPECT_EQ(r.forced_flips, 1u);
+  NarrowBand kept = after;
+  std::vector<float> values = r.values;
+  kept.swap_values(values);
+  EXPECT_EQ(invariant_breaches(kept), 0u);
+  EXPECT_EQ(inside_components(kept), 1u);
+  // The same change in a band that holds the whole rod is refused as usual.
+  const TopologyGuardResult w = guard_topology(band_of(both, -1.6, 1.6, h, 6.0), band_of(sphere, -1.6, 1.6, h, 6.0),
+                                               values_of(band_of(sphere, -1.6, 1.6, h, 6.0)), o);
+  EXPECT_EQ(w.forced_flips, 0u);
+  EXPECT_GT(w.refused_flips, 0u);
 }
 
 TEST(TopologyGuard, MismatchedInputsGiveTypedErrors) {
