@@ -11,6 +11,7 @@
 #include "apps/point_extent.hpp"
 #include "apps/point_sampling.hpp"
 #include "apps/reconstruction_parts.hpp"
+#include "apps/unique_points.hpp"
 #include "core/error.hpp"
 #include "surface/marching_cubes.hpp"
 
@@ -24,6 +25,9 @@ using detail::seconds_since;
 using detail::start_shell;
 
 constexpr double kGapClosing = 1.5;
+// Points this close (relative to the longest side of their box) are one point: float noise
+// of a copy, far below any grid (max_resolution 4096 is 2.4e-4).
+constexpr double kDuplicateTolerance = 1e-9;
 
 // The resolution when the caller gives none (see the header): voxels kSpacingVoxels sample
 // spacings wide, widened to kNoiseVoxels times the noise estimate, within [kAutoMin, kAutoMax].
@@ -121,8 +125,16 @@ ReconstructionResult reconstruct_surface(const std::vector<Vec3d>& input, const 
     require(longest_raw > 0.0 && std::isfinite(longest_raw), "all points are equal (or the extent is not finite)");
   }
   const double W = o.half_width;
-  std::vector<Vec3d> points(input.size());
-  for (std::size_t i = 0; i < input.size(); ++i) points[i] = input[i] - centre;
+  // Copies of a point (and coordinates equal to 1e-9 of the extent) count once: the k-nearest
+  // statistics and fits below assume distinct samples.
+  UniquePointsOptions unique;
+  unique.tolerance = kDuplicateTolerance * std::max({box.extent().x, box.extent().y, box.extent().z});
+  UniquePointsResult distinct = unique_points(input, unique);
+  require(distinct.points.size() >= 4,
+          "need at least 4 distinct points, got " + std::to_string(distinct.points.size()));
+  const std::vector<Vec3d>& cloud = distinct.points;
+  std::vector<Vec3d> points(cloud.size());
+  for (std::size_t i = 0; i < cloud.size(); ++i) points[i] = cloud[i] - centre;
   auto index = std::make_unique<PointIndex>(points);
   // The grid spans the cloud without its isolated points (far outliers of a scan), which
   // stay in the index but lie outside every grid; re-centred on that box.
@@ -133,7 +145,7 @@ ReconstructionResult reconstruct_surface(const std::vector<Vec3d>& input, const 
     box.min = extent.box.min + centre;
     box.max = extent.box.max + centre;
     centre = box.center();
-    for (std::size_t i = 0; i < input.size(); ++i) points[i] = input[i] - centre;
+    for (std::size_t i = 0; i < cloud.size(); ++i) points[i] = cloud[i] - centre;
     index = std::make_unique<PointIndex>(points);
   }
   const Vec3d ext = box.extent();
@@ -141,6 +153,7 @@ ReconstructionResult reconstruct_surface(const std::vector<Vec3d>& input, const 
   require(longest > 0.0 && std::isfinite(longest), "all points but isolated ones are equal");
   ReconstructionResult result;
   result.isolated_points = isolated;
+  result.duplicate_points = distinct.merged;
   result.sampling = estimate_sampling(*index, {16, 2000, o.progress});
   result.resolution = o.resolution > 0 ? o.resolution : 0;
   if (o.resolution == 0 && o.voxel_size <= 0.0) result.resolution = auto_resolution(result.sampling, longest, W);
@@ -154,6 +167,7 @@ ReconstructionResult reconstruct_surface(const std::vector<Vec3d>& input, const 
     if (o.log) o.log(line);
   };
 
+  if (distinct.merged > 0) log(std::to_string(distinct.merged) + " duplicate points merged");
   if (isolated > 0) log(std::to_string(isolated) + " isolated points outside the box the grids span");
   if (o.resolution == 0 && o.voxel_size <= 0.0) {
     char chosen[200];

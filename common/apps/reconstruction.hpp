@@ -2,8 +2,10 @@
 // (thesis 5.1.3, after Zhao, Osher and Fedkiw: the zero level of a narrow band moved by the
 // gradient flow of the distance to the data, with a curvature term, coarse to fine).
 //
-// Inputs: points (world units, finite, at least 4, not all equal); ReconstructionOptions.
+// Inputs: points (world units, finite, at least 4 distinct, not all equal); ReconstructionOptions.
 // Method:
+//   Duplicates (copies, and points within 1e-9 of the box's longest side: apps/unique_points.hpp)
+//   count once, counted in duplicate_points.
 //   Grid. Isolated points (a scan's far outliers: apps/point_extent.hpp) do not count
 //   towards the box; they stay in the point set, outside every grid. Points are shifted to
 //   their bounding-box centre (all work in float positions stays
@@ -94,7 +96,7 @@
 //   bench_reconstruct --sweep, resolution 256, one core: 2-4 s for 20k points (bunny, 0.1 %
 //   noise: 2.6 s, of it the coarsest level's flow 0.95 s, the final level's fits 0.8 s).
 // Threading: TBB throughout; the result is identical for any thread count.
-// Errors (thrown): Error{InvalidArgument} for fewer than 4 points, all points equal, bad
+// Errors (thrown): Error{InvalidArgument} for fewer than 4 (distinct) points, all points equal, bad
 //   options (resolution < 2 (W + 2) + 8, both resolution and voxel_size,
 //   half_width not in [2, 8], levels not in [1, 6], neighbors not in [1, 256], negative
 //   curvature weight, tolerance <= 0, max_steps < 1, snap_passes or clean_final_passes not in
@@ -183,6 +185,7 @@ struct ReconstructionResult {
   int resolution = 0;           // the final grid's (given, or chosen from the data); 0 with voxel_size
   SamplingEstimate sampling;    // the points' spacing and noise (world), measured first
   std::uint64_t isolated_points = 0;  // isolated points outside the box the grids span (apps/point_extent.hpp)
+  std::uint64_t duplicate_points = 0;  // copies merged before anything else (apps/unique_points.hpp)
   double seconds_mesh = 0.0;
   double seconds = 0.0;         // total
 };

@@ -85,6 +85,7 @@ int run(const ReconstructArgs& a) {
   stats.extra["resolution_from_data"] = a.resolution == 0 && a.voxel_size <= 0.0;
   stats.extra["sampling"] = {{"spacing", r.sampling.spacing}, {"noise", r.sampling.noise}};
   stats.extra["isolated_points"] = r.isolated_points;
+  stats.extra["duplicate_points"] = r.duplicate_points;
   stats.extra["steps"] = r.steps;
   stats.extra["triangles"] = r.measures.faces;
   stats.extra["genus"] = r.measures.genus;
