@@ -175,6 +175,10 @@ ReconstructionResult reconstruct_surface(const std::vector<Vec3d>& input, const 
                   result.resolution, result.sampling.spacing, result.sampling.noise, result.sampling.spacing / h_final,
                   result.sampling.noise / h_final);
     log(chosen);
+    const double asked = std::max(kSpacingVoxels * result.sampling.spacing, kNoiseVoxels * result.sampling.noise);
+    if (result.resolution == kAutoMax && asked < 0.5 * h_final)
+      log("the resolution is capped at " + std::to_string(kAutoMax) +
+          ": the spacing asks for finer voxels (parts far apart? give --resolution or --voxel-size)");
   }
   BBox local;
   local.min = box.min - centre;
@@ -238,6 +242,16 @@ ReconstructionResult reconstruct_surface(const std::vector<Vec3d>& input, const 
   MarchingCubesOptions mc;
   mc.progress = o.progress;
   result.mesh = marching_cubes(result.band, mc).mesh;
+  // No surface at all is never the answer for points: say why instead of writing an empty mesh.
+  if (result.mesh.triangles.empty()) {
+    char reason[320];
+    std::snprintf(reason, sizeof reason,
+                  "no surface left at voxel size %.4g (the points' spacing is %.4g): their parts are about a voxel "
+                  "thin or smaller at this resolution; give a finer resolution or voxel size, or reconstruct the "
+                  "parts separately",
+                  h_final, result.sampling.spacing);
+    throw Error(ErrorCode::InvalidArgument, "reconstruct", reason);
+  }
   result.measures = measure_mesh(result.mesh);
   result.seconds_mesh = seconds_since(t_mesh);
   result.voxel_size = h_final;

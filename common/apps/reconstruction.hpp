@@ -96,7 +96,9 @@
 //   bench_reconstruct --sweep, resolution 256, one core: 2-4 s for 20k points (bunny, 0.1 %
 //   noise: 2.6 s, of it the coarsest level's flow 0.95 s, the final level's fits 0.8 s).
 // Threading: TBB throughout; the result is identical for any thread count.
-// Errors (thrown): Error{InvalidArgument} for fewer than 4 (distinct) points, all points equal, bad
+// Errors (thrown): Error{InvalidArgument} when no surface is left (the parts are about a voxel
+//   thin or smaller at the resolution: two objects 1000 units apart at the automatic 512
+//   voxels), for fewer than 4 (distinct) points, all points equal, bad
 //   options (resolution < 2 (W + 2) + 8, both resolution and voxel_size,
 //   half_width not in [2, 8], levels not in [1, 6], neighbors not in [1, 256], negative
 //   curvature weight, tolerance <= 0, max_steps < 1, snap_passes or clean_final_passes not in

@@ -339,6 +339,23 @@ TEST(Reconstruction, AVolumetricCloudStillGivesAClosedMesh) {
   EXPECT_GT(r.mesh.triangles.size(), 1000u);
 }
 
+// Two unit spheres 1000 units apart: the automatic resolution stops at 512 voxels, about 2
+// units each, and nothing of either sphere is left. That is an error that says why, not an
+// empty mesh.
+TEST(Reconstruction, NoSurfaceLeftIsAnErrorThatSaysWhy) {
+  const auto sphere = make_sphere({0, 0, 0}, 1.0);
+  std::vector<Vec3d> points = samples(*sphere, 2000, 0.0, 8);
+  const std::size_t n = points.size();
+  for (std::size_t i = 0; i < n; ++i) points.push_back(points[i] + Vec3d{1000.0, 0.0, 0.0});
+  try {
+    reconstruct_surface(points, {});
+    ADD_FAILURE() << "an empty surface without an error";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.code(), ErrorCode::InvalidArgument);
+    EXPECT_NE(e.reason().find("no surface left"), std::string::npos) << e.what();
+  }
+}
+
 TEST(Reconstruction, BadInputsGiveTypedErrors) {
   auto code = [](const std::vector<Vec3d>& pts, const ReconstructionOptions& o) {
     try {
