@@ -8,27 +8,11 @@
 #include <vector>
 
 #include "core/error.hpp"
+#include "geometry/symmetric_eigen.hpp"
 
 namespace levelset::apps {
 
 namespace {
-
-// The smallest eigenvalue of a symmetric 3x3 matrix (closed form, trigonometric).
-double smallest_eigenvalue(double a, double b, double c, double d, double e, double f) {
-  // | a d e |
-  // | d b f |
-  // | e f c |
-  const double p1 = d * d + e * e + f * f;
-  const double q = (a + b + c) / 3.0;
-  if (p1 <= 1e-300) return std::min({a, b, c});
-  const double p2 = (a - q) * (a - q) + (b - q) * (b - q) + (c - q) * (c - q) + 2.0 * p1;
-  const double p = std::sqrt(p2 / 6.0);
-  const double ba = (a - q) / p, bb = (b - q) / p, bc = (c - q) / p, bd = d / p, be = e / p, bf = f / p;
-  const double det = ba * (bb * bc - bf * bf) - bd * (bd * bc - bf * be) + be * (bd * bf - bb * be);
-  const double r = std::clamp(det / 2.0, -1.0, 1.0);
-  const double phi = std::acos(r) / 3.0;
-  return q + 2.0 * p * std::cos(phi + 2.0 * std::numbers::pi / 3.0);
-}
 
 double median(std::vector<double>& v) {
   if (v.empty()) return 0.0;

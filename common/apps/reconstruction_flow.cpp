@@ -11,6 +11,7 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
+#include "apps/patch_coverage.hpp"
 #include "apps/reconstruction_parts.hpp"
 #include "distance/redistance.hpp"
 #include "evolve/evolution.hpp"
@@ -199,7 +200,11 @@ LevelOutput flow_level(NarrowBand band, const PointIndex& index, const Reconstru
     guard.eps = 1e-3 * h;
     guard.progress = o.progress;
     const double free_distance = o.free_distance * h;
-    guard.free = [&](const Coord& c) { return index.nearest(r.band.world(c)).distance > free_distance; };
+    // Far from every point, and not in a gap between the samples of a patch (apps/patch_coverage.hpp).
+    guard.free = [&](const Coord& c) {
+      const Vec3d x = r.band.world(c);
+      return index.nearest(x).distance > free_distance && !patch_coverage(index, x).inside;
+    };
     TopologyGuardResult kept =
         guard_topology(band, r.band, std::vector<float>(r.band.values().begin(), r.band.values().end()), guard);
     const std::uint64_t refused = kept.refused_flips;
