@@ -111,7 +111,9 @@
 //   level's dense grid 2^27 voxels; Error{Cancelled} through progress (checked between
 //   steps and inside each phase).
 // Log: options.log (may be empty) gets one line per level (steps, voxels, phase seconds) and
-//   one for the mesh, from the calling thread.
+//   one for the mesh, from the calling thread; a warning when under 70 % of the points lie
+//   near the surface (ReconstructionResult::coverage: a sampled open sheet collapses, parts
+//   thinner than a voxel vanish) and when the automatic resolution is capped.
 #pragma once
 
 #include <cstdint>
@@ -189,6 +191,7 @@ struct ReconstructionResult {
   SamplingEstimate sampling;    // the points' spacing and noise (world), measured first
   std::uint64_t isolated_points = 0;  // isolated points outside the box the grids span (apps/point_extent.hpp)
   std::uint64_t duplicate_points = 0;  // copies merged before anything else (apps/unique_points.hpp)
+  double coverage = 1.0;        // share of the points within max(2 h, 3 noise) of the surface (apps/surface_coverage.hpp)
   double seconds_mesh = 0.0;
   double seconds = 0.0;         // total
 };

@@ -98,6 +98,7 @@ void run_reconstruct_job(JobContext& ctx) {
                                 {"resolution_from_data", o.resolution == 0 && o.voxel_size <= 0.0},
                                 {"sampling", {{"spacing", result.sampling.spacing}, {"noise", result.sampling.noise}}},
                                 {"isolated_points", result.isolated_points}, {"duplicate_points", result.duplicate_points},
+                                {"coverage", result.coverage},
                                 {"levels", stages_json(result.stages)}};
   ctx.stats()["mesh"] = measures_json(result.measures);
 

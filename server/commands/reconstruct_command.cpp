@@ -86,6 +86,7 @@ int run(const ReconstructArgs& a) {
   stats.extra["sampling"] = {{"spacing", r.sampling.spacing}, {"noise", r.sampling.noise}};
   stats.extra["isolated_points"] = r.isolated_points;
   stats.extra["duplicate_points"] = r.duplicate_points;
+  stats.extra["coverage"] = r.coverage;
   stats.extra["steps"] = r.steps;
   stats.extra["triangles"] = r.measures.faces;
   stats.extra["genus"] = r.measures.genus;

@@ -191,6 +191,7 @@ TEST(Reconstruction, SphereIsSubVoxelAccurate) {
   // sheet or bump).
   EXPECT_LT(d.chamfer, 0.03) << d.chamfer;
   EXPECT_LT(d.hausdorff, 0.25) << d.hausdorff;
+  EXPECT_EQ(r.coverage, 1.0);  // every point within 2 voxels of the surface
   // Clean data: the final level snapped with the second-order fits, twice.
   EXPECT_TRUE(r.stages.back().second_order);
   EXPECT_EQ(r.stages.back().steps, 2);
