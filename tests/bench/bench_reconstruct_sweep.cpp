@@ -2,7 +2,7 @@
 // Open3D's screened Poisson on every closed, manifold mesh of CGAL's data/meshes with at least
 // 2,000 faces; points sampled by area (seeded), Gaussian noise as a fraction of the bounding-box
 // diagonal; the same points for both. Per case: Chamfer and Hausdorff (printed over the
-// diagonal; world units in the --jsonl records, with the diagonal),
+// diagonal; world units in the --jsonl records, with the diagonal and our coverage),
 // watertight, genus, components (against the true mesh's), seconds. Then a summary: wins and
 // losses on Chamfer, the median ratio, topology failures both ways, time.
 // Meshes whose features are thinner than 2 voxels at the resolution are measured and marked
@@ -212,6 +212,7 @@ struct CaseResult {
   Row ours, poisson;
   bool has_poisson = false;
   double ours_resolution = 0;
+  double ours_coverage = 0;  // share of the points near our surface (ReconstructionResult::coverage)
 };
 
 bool topology_right(const Row& r, const CaseResult& c) {
@@ -280,6 +281,7 @@ CaseResult run_case(const SweepMesh& m, const std::vector<Vec3d>& truth_samples,
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     c.ours = score(m.mesh, truth_samples, r.mesh, seconds);
     c.ours_resolution = r.resolution;
+    c.ours_coverage = r.coverage;
     if (!o.keep.empty()) {
       char key[256];
       std::snprintf(key, sizeof key, "%s-%zu-%g-%u", m.name.c_str(), count, noise, seed);
@@ -325,7 +327,8 @@ void print_case(const CaseResult& c, const SweepOptions& o) {
   if (o.jsonl.empty()) return;
   nlohmann::json j = {{"mesh", c.mesh},   {"points", c.points}, {"noise", c.noise},
                       {"seed", c.seed},   {"thin", c.thin},     {"truth", {{"genus", c.truth_genus}, {"components", c.truth_components}}},
-                      {"ours", row_json(c.ours)}, {"resolution", c.ours_resolution}, {"diagonal", c.diagonal}};
+                      {"ours", row_json(c.ours)}, {"resolution", c.ours_resolution}, {"coverage", c.ours_coverage},
+                      {"diagonal", c.diagonal}};
   if (c.has_poisson) j["poisson"] = row_json(c.poisson);
   std::ofstream(o.jsonl, std::ios::app) << j.dump() << "\n";
 }
