@@ -79,7 +79,8 @@
 //   voxel may change sign only next to the front and only where the flip keeps the topology
 //   (grid/topology_guard.hpp, also in the coarse flow except where no point lies within
 //   free_distance coarse voxels and the voxel is not in a gap between a sampled patch's points,
-//   apps/patch_coverage.hpp; components the data do not support are dropped after the
+//   apps/patch_coverage.hpp; a thin inside voxel holding a point within 0.75 coarse voxels, in
+//   such a patch, stays inside there (the guard's pinned rule: sheets do not erode); components the data do not support are dropped after the
 //   flow: sign_components), and the band is redistanced (fast sweeping, W)
 //   on its domain grown by one voxel (the front moved by up to one voxel; without the growth
 //   the band lacked voxels near the front where it moved outward, and the next upsampling or

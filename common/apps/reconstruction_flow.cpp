@@ -32,6 +32,8 @@ constexpr double kAttractionGain = 3.0;
 // fraction of them is a stray (drop_unsupported_components).
 constexpr double kMinSupport = 0.5;
 constexpr double kSupportDistance = 1.5;
+// The guard's pinned rule: a thin inside voxel with a point within this many coarse voxels.
+constexpr double kPinDistance = 0.75;
 
 // Mean front motion of the coarsest level's flow: the speed function adds |beta| of the
 // voxels within one voxel of the front (fixed point, so the sum is the same in any order:
@@ -204,6 +206,13 @@ LevelOutput flow_level(NarrowBand band, const PointIndex& index, const Reconstru
     guard.free = [&](const Coord& c) {
       const Vec3d x = r.band.world(c);
       return index.nearest(x).distance > free_distance && !patch_coverage(index, x).inside;
+    };
+    // A thin inside voxel holding data inside a sampled patch stays inside: a sampled sheet
+    // (an open scan, a part thinner than a coarse voxel) otherwise erodes from its rim by
+    // simple flips to a scrap. Not where the data are two sheets or an edge (bridges).
+    guard.pinned = [&](const Coord& c) {
+      const Vec3d x = r.band.world(c);
+      return index.nearest(x).distance <= kPinDistance * h && patch_coverage(index, x).inside;
     };
     TopologyGuardResult kept =
         guard_topology(band, r.band, std::vector<float>(r.band.values().begin(), r.band.values().end()), guard);

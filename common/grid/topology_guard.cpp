@@ -117,7 +117,8 @@ struct KeptTopology {
   std::uint64_t refused = 0, forced = 0;
 };
 KeptTopology keep_topology(const NarrowBand& before, const NarrowBand& after, std::vector<float>& values, double eps,
-                           const std::function<bool(const Coord&)>& free, const ProgressHook& progress) {
+                           const std::function<bool(const Coord&)>& free, const std::function<bool(const Coord&)>& pinned,
+                           const ProgressHook& progress) {
   struct Candidate {
     Coord c;
     std::size_t slot;
@@ -171,6 +172,12 @@ KeptTopology keep_topology(const NarrowBand& before, const NarrowBand& after, st
           if ((dx | dy | dz) != 0 && inside_now(cand.c + Coord{dx, dy, dz}))
             inside |= 1u << ((dz + 1) * 9 + (dy + 1) * 3 + dx + 1);
     const bool to_inside = values[cand.slot] < 0.0f;
+    if (!to_inside && pinned && !must_flip[k]) {
+      auto in_at = [&](int dx, int dy, int dz) { return bool((inside >> ((dz + 1) * 9 + (dy + 1) * 3 + dx + 1)) & 1u); };
+      const bool thin = (!in_at(-1, 0, 0) && !in_at(1, 0, 0)) || (!in_at(0, -1, 0) && !in_at(0, 1, 0)) ||
+                        (!in_at(0, 0, -1) && !in_at(0, 0, 1));
+      if (thin && pinned(cand.c)) continue;
+    }
     const bool keeps = simple_voxel(inside) && !ambiguous_face_at_centre(inside, !to_inside) &&
                        !ambiguous_face_at_centre(inside, to_inside);
     if (!keeps && !(free && free(cand.c))) {
@@ -301,7 +308,7 @@ TopologyGuardResult guard_topology(const NarrowBand& before, const NarrowBand& a
   TopologyGuardResult r;
   if (!(options.eps > 0.0) || !std::isfinite(options.eps))
     throw Error(ErrorCode::InvalidArgument, "guard_topology", "eps must be a positive number (a refused flip's |value|)");
-  const KeptTopology kept = keep_topology(before, after, values, options.eps, options.free, options.progress);
+  const KeptTopology kept = keep_topology(before, after, values, options.eps, options.free, options.pinned, options.progress);
   r.refused_flips = kept.refused;
   r.forced_flips = kept.forced;
   r.restored_values = keep_face_decisions(before, after, values);

@@ -26,6 +26,10 @@
 //      corners, its four corners go back to their values in `before` (same signs), repeated
 //      until no face changes. Why: a thin part otherwise gains a handle or breaks with every
 //      sign change simple (measured on the bunny's ears in the reconstruction's snaps).
+//   3. options.pinned(c), when given and true, keeps an inside voxel inside where it is thin
+//      (both face neighbours along some axis outside), unless rule 1 forces its flip: a sheet
+//      one voxel thick loses its voxels from the rim inward by simple flips alone, so topology
+//      alone does not keep it (the caller pins the voxels that hold data).
 // Output: TopologyGuardResult (the values, how many flips were refused, how many values were
 //   restored for face decisions).
 // Errors: Error{InvalidArgument} when values.size() is not after's active voxel count, the
@@ -51,6 +55,7 @@ namespace levelset {
 struct TopologyGuardOptions {
   double eps = 0.0;                        // world, > 0: |value| given to a refused flip's voxel
   std::function<bool(const Coord&)> free;  // optional: flips allowed at any topology cost here
+  std::function<bool(const Coord&)> pinned;  // optional: a thin inside voxel here stays inside (rule 3)
   ProgressHook progress;                   // checked every 2^16 flip tests
 };
 

@@ -84,6 +84,32 @@ TEST(TopologyGuard, GrowingABallIsSimpleEverywhere) {
   EXPECT_EQ(r.values, proposed);
 }
 
+TEST(TopologyGuard, PinnedThinVoxelsStayWhereSimpleFlipsWouldErodeTheSheet) {
+  // A disc one voxel thick, proposed to go wholly outside. Each flip at its rim is simple, so
+  // the guard alone lets it erode to its last voxel; pinned voxels where it is thin stay.
+  const double h = 0.1;
+  auto disc = [&](const Vec3d& p) { return std::max(std::abs(p.z) - 0.5 * h, std::hypot(p.x, p.y) - 0.8); };
+  const NarrowBand band = band_of(disc, -1.2, 1.2, h);
+  std::vector<float> proposed = values_of(band);
+  for (float& v : proposed) v = std::abs(v) + 0.01f;
+  auto inside_count = [](const std::vector<float>& values) {
+    std::size_t n = 0;
+    for (float v : values) n += v < 0.0f;
+    return n;
+  };
+  const std::size_t before = inside_count(values_of(band));
+  ASSERT_GT(before, 150u);
+  TopologyGuardOptions o;
+  o.eps = 1e-3 * h;
+  const TopologyGuardResult eroded = guard_topology(band, band, proposed, o);
+  EXPECT_LT(inside_count(eroded.values), before / 10);
+  o.pinned = [](const Coord& c) { return c.x >= 0; };  // half of it holds data
+  const TopologyGuardResult kept = guard_topology(band, band, proposed, o);
+  const std::size_t left = inside_count(kept.values);
+  EXPECT_GE(left, before / 2 - 10);
+  EXPECT_LT(left, before);
+}
+
 TEST(TopologyGuard, AmbiguousFaceKeepsItsDecision) {
   // Two balls whose insides meet only across a face diagonal at the origin's face: before,
   // the face's inside corners are joined (v00 v11 > v10 v01); the proposal keeps all signs but
