@@ -113,13 +113,35 @@ inline void copy_row(const float* src, float* dst, int width) {
   }
 }
 
+// Sign of the unallocated neighbour d of around's brick (one sign for the whole brick: band
+// invariant), by the band's x-row rule at the neighbour's local voxel nlo; when the next brick
+// along +x is a neighbour here, that rule reads its first column, without the search.
+bool unallocated_inside(const NarrowBand& band, const Neighborhood& around, const Coord& d, const int nlo[3]) {
+  const std::uint32_t next = d.x < 1 ? around[std::size_t(Neighborhood::slot(d.x + 1, d.y, d.z))] : kNoBrick;
+  if (next != kNoBrick) return band.voxel_inside(next, local_index(0, nlo[1], nlo[2]));
+  const Coord self = band.bricks()[around[std::size_t(Neighborhood::slot(0, 0, 0))]].coord;
+  return band.is_inside_unallocated(brick_origin(self + d) + Coord{nlo[0], nlo[1], nlo[2]});
+}
+
+// Local range [nlo, nhi) per axis of neighbour d that falls into the box [lo, hi)^3; false
+// when it is empty.
+bool neighbor_range(const Coord& d, int lo, int hi, int nlo[3], int nhi[3]) {
+  bool empty = false;
+  for (int a = 0; a < 3; ++a) {
+    nlo[a] = d[a] < 0 ? kBrickDim + lo : 0;
+    nhi[a] = d[a] > 0 ? hi - kBrickDim : kBrickDim;
+    empty |= nlo[a] >= nhi[a];
+  }
+  return !empty;
+}
+
 // The box of gather_box, its unallocated neighbours filled here; fill_row(nb, brick, z, y, x0,
 // x1, width, dst) writes local x in [x0, x1) (width = x1 - x0) of row (y, z) of allocated
 // neighbour nb to dst[x].
 template <typename FillRow>
 void gather_box_rows(const NarrowBand& band, const Neighborhood& around, int lo, int hi, std::span<float> out,
-                     std::span<std::uint32_t> active_rows, GatherRegion region, FillRow&& fill_row) {
-  const std::uint32_t brick = around[std::size_t(Neighborhood::slot(0, 0, 0))];
+                     std::span<std::uint32_t> active_rows, GatherRegion region, NeighborSigns* signs,
+                     FillRow&& fill_row) {
   if (lo < -kBrickDim || lo > 0 || hi < kBrickDim || hi > 2 * kBrickDim)
     throw Error(ErrorCode::InvalidArgument, "gather_box", "need -8 <= lo <= 0 and 8 <= hi <= 16");
   const std::size_t dim = std::size_t(hi - lo);
@@ -130,7 +152,6 @@ void gather_box_rows(const NarrowBand& band, const Neighborhood& around, int lo,
     throw Error(ErrorCode::InvalidArgument, "gather_box", "active_rows size must be (hi - lo)^2");
   if (rows) std::fill(active_rows.begin(), active_rows.end(), 0u);
   const float bg = band.background();
-  const Coord self = band.bricks()[brick].coord;
   // Box index of local voxel (x, y, z).
   auto index = [&](int x, int y, int z) {
     return std::size_t(x - lo) + dim * (std::size_t(y - lo) + dim * std::size_t(z - lo));
@@ -140,25 +161,25 @@ void gather_box_rows(const NarrowBand& band, const Neighborhood& around, int lo,
       for (int dx = -1; dx <= 1; ++dx) {
         const Coord d{dx, dy, dz};
         if (region == GatherRegion::Star && (dx != 0) + (dy != 0) + (dz != 0) > 1) continue;
-        // Local range of the neighbour that falls into the box, per axis.
         int nlo[3], nhi[3];
-        bool empty = false;
-        for (int a = 0; a < 3; ++a) {
-          nlo[a] = d[a] < 0 ? kBrickDim + lo : 0;
-          nhi[a] = d[a] > 0 ? hi - kBrickDim : kBrickDim;
-          empty |= nlo[a] >= nhi[a];
-        }
-        if (empty) continue;
+        if (!neighbor_range(d, lo, hi, nlo, nhi)) continue;
         const std::uint32_t nb = around[std::size_t(Neighborhood::slot(dx, dy, dz))];
         const int width = nhi[0] - nlo[0];
         if (nb == kNoBrick) {
           // Unallocated: one sign for the whole brick (band invariant), by the band's x-row
           // rule; when the next brick along +x is a neighbour here, that rule reads its first
           // column, without the search.
-          const std::uint32_t next = dx < 1 ? around[std::size_t(Neighborhood::slot(dx + 1, dy, dz))] : kNoBrick;
-          const bool inside = next != kNoBrick
-                                  ? band.voxel_inside(next, local_index(0, nlo[1], nlo[2]))
-                                  : band.is_inside_unallocated(brick_origin(self + d) + Coord{nlo[0], nlo[1], nlo[2]});
+          const std::uint32_t bit = 1u << Neighborhood::slot(dx, dy, dz);
+          bool inside;
+          if (signs && (signs->known & bit)) {
+            inside = (signs->inside & bit) != 0;
+          } else {
+            inside = unallocated_inside(band, around, d, nlo);
+            if (signs) {
+              signs->known |= bit;
+              if (inside) signs->inside |= bit;
+            }
+          }
           const float v = inside ? -bg : bg;
           for (int z = nlo[2]; z < nhi[2]; ++z)
             for (int y = nlo[1]; y < nhi[1]; ++y)
@@ -198,7 +219,7 @@ void gather_box(const NarrowBand& band, const Neighborhood& around, int lo, int 
   const float* all_values = band.values().data();
   // A row of a brick is one byte of its masks, and its active values are contiguous in the
   // packed storage.
-  gather_box_rows(band, around, lo, hi, out, active_rows, GatherRegion::Box,
+  gather_box_rows(band, around, lo, hi, out, active_rows, GatherRegion::Box, nullptr,
                   [&](std::uint32_t, const Brick& br, int z, int y, int x0, int x1, int width, float* dst) {
     const std::uint64_t act_word = br.active.words[std::size_t(z)];
     const int bit0 = 8 * y;
@@ -222,6 +243,18 @@ void gather_box(const NarrowBand& band, const Neighborhood& around, int lo, int 
   });
 }
 
+NeighborSigns resolve_neighbor_signs(const NarrowBand& band, const Neighborhood& around, int lo, int hi) {
+  NeighborSigns signs;
+  for (int k = 0; k < 27; ++k) {
+    const Coord d = Neighborhood::offset(k);
+    int nlo[3], nhi[3];
+    if (around[std::size_t(k)] != kNoBrick || !neighbor_range(d, lo, hi, nlo, nhi)) continue;
+    signs.known |= 1u << k;
+    if (unallocated_inside(band, around, d, nlo)) signs.inside |= 1u << k;
+  }
+  return signs;
+}
+
 DecodedBricks decode_bricks(const NarrowBand& band) {
   DecodedBricks out;
   out.size = band.brick_count() * std::size_t(kBrickVoxels);
@@ -240,10 +273,10 @@ DecodedBricks decode_bricks(const NarrowBand& band) {
 }
 
 void gather_box(const NarrowBand& band, std::span<const float> decoded, const Neighborhood& around, int lo, int hi,
-                std::span<float> out, std::span<std::uint32_t> active_rows, GatherRegion region) {
+                std::span<float> out, std::span<std::uint32_t> active_rows, GatherRegion region, NeighborSigns* signs) {
   if (decoded.size() != band.brick_count() * std::size_t(kBrickVoxels))
     throw Error(ErrorCode::InvalidArgument, "gather_box", "decoded bricks do not match the band");
-  gather_box_rows(band, around, lo, hi, out, active_rows, region,
+  gather_box_rows(band, around, lo, hi, out, active_rows, region, signs,
                   [&](std::uint32_t nb, const Brick&, int z, int y, int x0, int, int width, float* dst) {
     copy_row(decoded.data() + std::size_t(nb) * kBrickVoxels + std::size_t(local_index(x0, y, z)), dst + x0, width);
   });

@@ -76,9 +76,20 @@ DecodedBricks decode_bricks(const NarrowBand& band);
 // six face neighbours: what lines along the axes through the brick's voxels read, 61% of a
 // 14^3 box). Outside the star the values are left as they were and the active rows read 0.
 enum class GatherRegion { Box, Star };
-// gather_box from decode_bricks(band): the same output, by row copies.
+// The inside sign of a neighbourhood's unallocated bricks (bit Neighborhood::slot), resolved
+// on first need by the band's x-row rule (a search over the bricks): a pass that gathers the
+// same brick's box again passes the signs the first gather resolved.
+struct NeighborSigns {
+  std::uint32_t known = 0;
+  std::uint32_t inside = 0;
+};
+// The signs gather_box resolves for the box [lo, hi)^3 around around's brick, all at once.
+NeighborSigns resolve_neighbor_signs(const NarrowBand& band, const Neighborhood& around, int lo, int hi);
+// gather_box from decode_bricks(band): the same output, by row copies. signs: null, or
+// resolved / reused signs of this neighbourhood's unallocated bricks.
 void gather_box(const NarrowBand& band, std::span<const float> decoded, const Neighborhood& around, int lo, int hi,
-                std::span<float> out, std::span<std::uint32_t> active_rows, GatherRegion region = GatherRegion::Box);
+                std::span<float> out, std::span<std::uint32_t> active_rows, GatherRegion region = GatherRegion::Box,
+                NeighborSigns* signs = nullptr);
 
 // Writes tile values back to the active voxels of the brick (inactive voxels untouched,
 // signs of active voxels updated). tile is laid out with the given halo.

@@ -1,5 +1,6 @@
 #include "surface/cell_loops.hpp"
 
+#include <array>
 #include <vector>
 
 namespace levelset::cell {
@@ -109,6 +110,12 @@ LoopSet trace(int m, int decisions) {
       s.doubled_faces[s.loop_of_edge[p[0]]] |= std::uint8_t(1u << p[2]);
     }
   }
+  for (int l = 0; l < s.loop_count; ++l) {
+    const int n = s.length[l];
+    const bool centre = n > 3 && ((s.doubled_face_loops >> l) & 1);
+    s.fan_triangles = std::uint8_t(s.fan_triangles + (n == 3 ? 1 : centre ? n : n - 2));
+    s.centre_vertices = std::uint8_t(s.centre_vertices + (centre ? 1 : 0));
+  }
   return s;
 }
 
@@ -138,6 +145,16 @@ struct Table {
 };
 
 }  // namespace
+
+int unambiguous_triangles(int inside_mask) {
+  static const std::array<std::int8_t, 256> table = [] {
+    std::array<std::int8_t, 256> t{};
+    for (int m = 0; m < 256; ++m)
+      t[std::size_t(m)] = ambiguous_faces(m) != 0 ? std::int8_t(-1) : std::int8_t(loops_for(m, 0).fan_triangles);
+    return t;
+  }();
+  return table[std::size_t(inside_mask)];
+}
 
 const LoopSet& loops_for(int inside_mask, int face_decisions) {
   static const Table table;

@@ -42,6 +42,10 @@ struct LoopSet {
   std::uint8_t doubled_face_loops = 0;
   // Per loop: bit f set when the loop holds both segments of face f.
   std::array<std::uint8_t, 4> doubled_faces{};
+  // What marching cubes emits for this set (its counting pass reads these): a triangle per
+  // 3-loop, a fan of n - 2 per other loop, and a centre vertex with n triangles per doubled one.
+  std::uint8_t fan_triangles = 0;
+  std::uint8_t centre_vertices = 0;
 };
 
 // The face (2 * axis + side) holding both edges e0 and e1 of one cell, -1 if none.
@@ -54,6 +58,10 @@ int edge_from_lower_neighbor(int e, int a);
 // Loops for the inside mask (bit i: corner i inside) and face decisions (bit f: on face f,
 // when it has 4 crossings, the inside corners are connected across the face).
 const LoopSet& loops_for(int inside_mask, int face_decisions);
+
+// The fan_triangles of loops_for(m, 0) when m has no face with 4 crossings (then its loops do
+// not depend on the face decisions, and it has no centre vertex); -1 when it has one.
+int unambiguous_triangles(int inside_mask);
 
 // Face corners of face f in the canonical order (0,0),(1,0),(1,1),(0,1) over the face's two
 // axes in increasing order.

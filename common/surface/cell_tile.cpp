@@ -11,7 +11,16 @@ void gather_cell_tile(const NarrowBand& band, std::uint32_t brick, CellTile& til
   if (decoded.empty())
     gather_box(band, around, -CellTile::kHalo, CellTile::kDim - CellTile::kHalo, values, rows);
   else
-    gather_box(band, decoded, around, -CellTile::kHalo, CellTile::kDim - CellTile::kHalo, values, rows);
+    regather_cell_tile(band, around, NeighborSigns{}, tile, decoded);
+  tile.around = around;
+}
+
+void regather_cell_tile(const NarrowBand& band, const Neighborhood& around, const NeighborSigns& signs,
+                        CellTile& tile, std::span<const float> decoded) {
+  tile.signs = signs;
+  gather_box(band, decoded, around, -CellTile::kHalo, CellTile::kDim - CellTile::kHalo,
+             std::span<float>(tile.values.data(), CellTile::kSize), std::span<std::uint32_t>(tile.active_rows),
+             GatherRegion::Box, &tile.signs);
   tile.around = around;
 }
 

@@ -32,9 +32,14 @@ struct CellTile {
   static constexpr int row(int y, int z) { return (y + kHalo) + kDim * (z + kHalo); }
   std::array<std::uint32_t, kDim * kDim> active_rows{};
   Neighborhood around{};
+  NeighborSigns signs{};  // of around's unallocated bricks (with decoded only)
 };
 
 // decoded: decode_bricks(band) (the tile is then gathered by row copies) or empty.
 void gather_cell_tile(const NarrowBand& band, std::uint32_t brick, CellTile& tile, std::span<const float> decoded = {});
+// Gathers the same brick again from decoded, with the neighbourhood and the signs an earlier
+// gather of it left in a tile (no neighbour search).
+void regather_cell_tile(const NarrowBand& band, const Neighborhood& around, const NeighborSigns& signs,
+                        CellTile& tile, std::span<const float> decoded);
 
 }  // namespace levelset

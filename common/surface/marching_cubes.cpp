@@ -6,12 +6,14 @@
 #include <chrono>
 #include <cmath>
 #include <span>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
 #include <tbb/enumerable_thread_specific.h>
 
 #include "core/error.hpp"
+#include "surface/band_masks.hpp"
 #include "surface/cell_loops.hpp"
 #include "surface/cell_tile.hpp"
 #include "surface/surface_common.hpp"
@@ -22,70 +24,42 @@ using namespace surface_detail;
 
 namespace {
 
-constexpr int kEdgeSlots = kBrickVoxels * 3;  // 1536; centroids follow
+constexpr int kEdgeSlots = kBrickVoxels * 3;  // 1536
 
-// One brick's output: built in the thread's Scratch, kept in its OutputArena.
-struct BrickBuild {
-  std::vector<Vec3d> vertices;  // owned edge vertices in slot order, then centroids
-  std::vector<Vec3f> normals;
-  std::vector<std::array<VertexKey, 3>> triangles;
-  Neighborhood around{};
-};
-struct BrickOut {
-  std::span<const Vec3d> vertices;
-  std::span<const Vec3f> normals;
-  std::span<const std::array<VertexKey, 3>> triangles;
-  Neighborhood around{};
+// The counting pass's record of one brick: the edge slots that own a vertex and what the brick
+// writes. The writing pass writes at the prefix sums, straight into the result.
+struct BrickCount {
   SlotBits<kEdgeSlots> owned;
   std::uint32_t edge_vertices = 0;
-  std::uint64_t cells = 0;
-  std::uint32_t extra = 0;
+  std::uint32_t centres = 0;  // loop-centre vertices, after the edge vertices
+  std::uint32_t triangles = 0;
+  std::uint32_t cells = 0;
+  Neighborhood around{};  // what the tile was gathered with: pass 2 gathers without searching
+  NeighborSigns signs{};
 };
 
-// Per-thread scratch: the tile, its edge crossings, the brick being built and the arena that
-// keeps the built bricks.
+// Per-thread scratch: the tile, its cell classes and edge crossings.
 struct Scratch {
   CellTile tile;
+  ValidCells valid;
   EdgeCrossings edges;
-  BrickBuild build;
-  OutputArena arena;
 };
 
-void process_brick(const NarrowBand& band, std::span<const float> decoded, std::uint32_t b, double iso,
-                   Scratch& scratch, BrickOut& kept) {  // owned slots and counts go straight into kept
-  CellTile& t = scratch.tile;
-  const double h = band.voxel_size();
-  ValidCells valid;
-  BrickBuild& out = scratch.build;
-  out.vertices.clear();
-  out.normals.clear();
-  out.triangles.clear();
-  const Vec3d corner = begin_brick(band, b, iso, t, valid, out, decoded);
-  out.triangles.reserve(2 * valid.mixed_cells + 8);
-
-  // Edge crossings of the cells [0, 8)^3, and the vertices of the owned ones in slot order.
-  scratch.edges.compute(t, valid, iso, 0);
+// The grid edges from voxels in [0, 8)^3 that cross iso and belong to a contoured cell, in slot
+// order: f(x, y, z, axis).
+template <typename F>
+void for_each_owned_edge(const ValidCells& valid, F&& f) {
   for (int z = 0; z < kBrickDim; ++z)
-    for (int y = 0; y < kBrickDim; ++y) {
-      std::uint32_t cr[3];
-      valid.crossing_edges(y, z, cr);
-      for (std::uint32_t bits = (cr[0] | cr[1] | cr[2]) & ValidCells::x_bits(0, kBrickDim); bits != 0; bits &= bits - 1) {
-        const int x = std::countr_zero(bits) - 1;
-        const int p = CellTile::index(x, y, z);
-        for (int a = 0; a < 3; ++a) {
-          if (!((cr[a] >> (x + 1)) & 1u) || !valid.edge_used(x, y, z, a)) continue;
-          kept.owned.set(3 * local_index(x, y, z) + a);
-          const double s = scratch.edges.at(p, a);
-          out.vertices.push_back(corner + scratch.edges.point(x, y, z, a) * h);
-          out.normals.push_back(normalized_f(corner_gradient(t, p) * (1.0 - s) + corner_gradient(t, p + kTileStride[a]) * s));
-        }
+    for (int y = 0; y < kBrickDim; ++y)
+      for (std::uint32_t bits = valid.owned_edges(y, z); bits != 0; bits &= bits - 1) {
+        const int k = std::countr_zero(bits);
+        f(k / 3, y, z, k % 3);
       }
-    }
-  kept.edge_vertices = std::uint32_t(out.vertices.size());
+}
 
-  // Cells.
-  std::array<Vec3d, 12> pos;
-  std::array<VertexKey, 12> key;
+// The contoured cells of [0, 8)^3 that cross iso, in cell order: f(x, y, z, loops).
+template <typename F>
+void for_each_mixed_cell(const CellTile& t, const ValidCells& valid, double iso, F&& f) {
   for (int z = 0; z < kBrickDim; ++z)
     for (int y = 0; y < kBrickDim; ++y)
       for (std::uint32_t bits = (valid.mixed_row(y, z) >> ValidCells::kH) & 0xffu; bits != 0; bits &= bits - 1) {
@@ -96,47 +70,118 @@ void process_brick(const NarrowBand& band, std::span<const float> decoded, std::
         int m, d;
         cell::classify(a, m, d);
         if (m == 0 || m == 255) continue;
-        ++kept.cells;
-        const cell::LoopSet& ls = cell::loops_for(m, d);
-        for (int l = 0; l < ls.loop_count; ++l) {
-          const int n = ls.length[l];
-          const std::uint8_t* edges = &ls.edges[ls.begin[l]];
-          for (int i = 0; i < n; ++i) {
-            const int e = edges[i];
-            const int c = cell::edge_lower_corner(e);
-            const int ex = x + (c & 1), ey = y + ((c >> 1) & 1), ez = z + ((c >> 2) & 1);
-            key[i] = vertex_key(Neighborhood::slot(ex >> 3, ey >> 3, ez >> 3),
-                                3 * local_index(ex & 7, ey & 7, ez & 7) + (e >> 2));
-          }
-          if (n == 3) {
-            out.triangles.push_back({key[0], key[1], key[2]});
-            continue;
-          }
-          for (int i = 0; i < n; ++i) {
-            const int e = edges[i];
-            const int c = cell::edge_lower_corner(e);
-            pos[i] = scratch.edges.point(x + (c & 1), y + ((c >> 1) & 1), z + ((c >> 2) & 1), e >> 2);
-          }
-          if ((ls.doubled_face_loops >> l) & 1) {
-            Vec3d c{};
-            for (int i = 0; i < n; ++i) c += pos[i];
-            c = c / double(n);
-            const VertexKey ck = vertex_key(Neighborhood::slot(0, 0, 0), kEdgeSlots + int(kept.extra));
-            out.vertices.push_back(corner + c * h);
-            out.normals.push_back(normalized_f(gradient_at(t, c, x, y, z)));
-            ++kept.extra;
-            for (int i = 0; i < n; ++i) out.triangles.push_back({ck, key[i], key[(i + 1) % n]});
-            continue;
-          }
-          const int s = best_fan_start(pos.data(), n);
-          for (int i = 1; i + 1 < n; ++i)
-            out.triangles.push_back({key[s], key[(s + i) % n], key[(s + i + 1) % n]});
-        }
+        f(x, y, z, cell::loops_for(m, d));
       }
-  kept.around = out.around;
-  kept.vertices = scratch.arena.keep(out.vertices);
-  kept.normals = scratch.arena.keep(out.normals);
-  kept.triangles = scratch.arena.keep(out.triangles);
+}
+
+// Pass 1 from the masks alone: the owned edges and, per contoured cell, its loop set's
+// counts (values are read only for a cell with an ambiguous face, whose loops depend on them).
+void count_brick(const NarrowBand& band, const DecodedBand& decoded, std::uint32_t b, double iso, Scratch& s,
+                 BrickCount& c) {
+  c.around = brick_neighborhood(band, b);
+  c.signs = resolve_neighbor_signs(band, c.around, -CellTile::kHalo, CellTile::kDim - CellTile::kHalo);
+  ValidCells& valid = s.valid;
+  cell_masks(band, decoded, c.around, c.signs, valid);
+  for (int z = 0; z < kBrickDim; ++z)
+    for (int y = 0; y < kBrickDim; ++y) {
+      const std::uint32_t bits = valid.owned_edges(y, z);
+      c.owned.set_bits(3 * local_index(0, y, z), bits);
+      c.edge_vertices += std::uint32_t(std::popcount(bits));
+    }
+  c.owned.finish();
+  for (int z = 0; z < kBrickDim; ++z)
+    for (int y = 0; y < kBrickDim; ++y) {
+      const std::uint32_t rows[4] = {valid.inside_rows[std::size_t(ValidCells::row(y, z))],
+                                     valid.inside_rows[std::size_t(ValidCells::row(y + 1, z))],
+                                     valid.inside_rows[std::size_t(ValidCells::row(y, z + 1))],
+                                     valid.inside_rows[std::size_t(ValidCells::row(y + 1, z + 1))]};
+      for (std::uint32_t bits = (valid.mixed_row(y, z) >> ValidCells::kH) & 0xffu; bits != 0; bits &= bits - 1) {
+        const int x = std::countr_zero(bits);
+        int m = 0;
+        for (int i = 0; i < 8; ++i) m |= int((rows[i >> 1] >> (x + (i & 1) + ValidCells::kH)) & 1u) << i;
+        ++c.cells;
+        if (const int plain = cell::unambiguous_triangles(m); plain >= 0) {
+          c.triangles += std::uint32_t(plain);
+          continue;
+        }
+        double a[8];
+        for (int i = 0; i < 8; ++i)
+          a[i] = corner_value(decoded, c.around, x + (i & 1), y + ((i >> 1) & 1), z + ((i >> 2) & 1), iso);
+        int m2, d;
+        cell::classify(a, m2, d);
+        const cell::LoopSet& ls = cell::loops_for(m2, d);
+        c.triangles += ls.fan_triangles;
+        c.centres += ls.centre_vertices;
+      }
+    }
+}
+
+// Where each brick's output starts in the result (bricks + 1 entries each).
+struct Bases {
+  std::vector<std::uint32_t> vertex;
+  std::vector<std::uint64_t> triangle;
+};
+
+// Writes brick b's vertices, normals and triangles (global indices) at its bases; the same
+// enumeration as count_brick, so the ranks of the owned slots are the write positions.
+void write_brick(const NarrowBand& band, const DecodedBand& decoded, std::uint32_t b, double iso,
+                 std::span<const BrickCount> counts, const Bases& at, Scratch& s, SurfaceResult& r) {
+  regather_cell_tile(band, counts[b].around, counts[b].signs, s.tile, decoded.values.values());
+  s.valid.compute(s.tile, iso);
+  const CellTile& t = s.tile;
+  const Coord base = brick_origin(band.bricks()[b].coord);
+  const Vec3d corner = band.origin() + Vec3d{double(base.x), double(base.y), double(base.z)} * band.voxel_size();
+  const double h = band.voxel_size();
+  s.edges.compute(t, s.valid, iso, 0);
+  Vec3d* vertex = r.mesh.vertices.data() + at.vertex[b];
+  Vec3f* normal = r.normals.data() + at.vertex[b];
+  // The two passes enumerate the same data the same way; a difference is a bug, not input,
+  // and must not write outside the brick's range.
+  const Vec3d* const vertex_end = r.mesh.vertices.data() + at.vertex[b + 1];
+  const std::array<std::uint32_t, 3>* const tri_end = r.mesh.triangles.data() + at.triangle[b + 1];
+  auto differs = [] { return std::logic_error("marching_cubes: brick output differs from its count"); };
+  for_each_owned_edge(s.valid, [&](int x, int y, int z, int a) {
+    if (vertex == vertex_end) throw differs();
+    const int p = CellTile::index(x, y, z);
+    const double u = s.edges.at(p, a);
+    *vertex++ = corner + s.edges.point(x, y, z, a) * h;
+    *normal++ = normalized_f(corner_gradient(t, p) * (1.0 - u) + corner_gradient(t, p + kTileStride[a]) * u);
+  });
+  std::uint32_t centre = at.vertex[b] + counts[b].edge_vertices;
+  std::array<std::uint32_t, 3>* tri = r.mesh.triangles.data() + at.triangle[b];
+  std::array<Vec3d, 12> pos;
+  std::array<std::uint32_t, 12> index;
+  for_each_mixed_cell(t, s.valid, iso, [&](int x, int y, int z, const cell::LoopSet& ls) {
+    if (tri_end - tri < ls.fan_triangles || vertex_end - vertex < ls.centre_vertices) throw differs();
+    for (int l = 0; l < ls.loop_count; ++l) {
+      const int n = ls.length[l];
+      const std::uint8_t* edges = &ls.edges[ls.begin[l]];
+      for (int i = 0; i < n; ++i) {
+        const int c = cell::edge_lower_corner(edges[i]);
+        const int ex = x + (c & 1), ey = y + ((c >> 1) & 1), ez = z + ((c >> 2) & 1);
+        const std::uint32_t owner = t.around[std::size_t(Neighborhood::slot(ex >> 3, ey >> 3, ez >> 3))];
+        index[i] = at.vertex[owner] + counts[owner].owned.rank(3 * local_index(ex & 7, ey & 7, ez & 7) + (edges[i] >> 2));
+        if (n > 3) pos[i] = s.edges.point(ex, ey, ez, edges[i] >> 2);
+      }
+      if (n == 3) {
+        *tri++ = {index[0], index[1], index[2]};
+        continue;
+      }
+      if ((ls.doubled_face_loops >> l) & 1) {
+        Vec3d c{};
+        for (int i = 0; i < n; ++i) c += pos[i];
+        c = c / double(n);
+        *vertex++ = corner + c * h;
+        *normal++ = normalized_f(gradient_at(t, c, x, y, z));
+        for (int i = 0; i < n; ++i) *tri++ = {centre, index[i], index[(i + 1) % n]};
+        ++centre;
+        continue;
+      }
+      const int f = best_fan_start(pos.data(), n);
+      for (int i = 1; i + 1 < n; ++i) *tri++ = {index[f], index[(f + i) % n], index[(f + i + 1) % n]};
+    }
+  });
+  if (vertex != vertex_end || tri != tri_end) throw differs();
 }
 
 }  // namespace
@@ -145,24 +190,33 @@ SurfaceResult marching_cubes(const NarrowBand& band, const MarchingCubesOptions&
   const auto start = std::chrono::steady_clock::now();
   check_iso(band, options.iso, "marching_cubes");
   const std::uint32_t nb = std::uint32_t(band.brick_count());
-  std::vector<BrickOut> outs(nb);
-  const std::vector<std::uint8_t> work = bricks_with_crossings(band, options.iso);
   tbb::enumerable_thread_specific<Scratch> scratch;
-  // Each brick decoded once (its tile and its neighbours' tiles then copy rows).
-  const DecodedBricks decoded = decode_bricks(band);
+  // Each brick decoded once with its inside mask: pass 1 counts from the masks, pass 2 gathers
+  // tiles by row copies and writes into the sized result. No per-brick output buffers and no
+  // copy (those were ~100 MB of fresh memory per call at R = 512; page faults are slow).
+  const DecodedBand decoded = decode_band(band, options.iso);
+  std::vector<BrickCount> counts;
+  resize_with_huge_pages(counts, nb);
   for_brick_batches(nb, options.progress, "marching_cubes", [&](std::uint32_t b) {
-    if (work[b]) process_brick(band, decoded.values(), b, options.iso, scratch.local(), outs[b]);
-  });
+    if (decoded.work[b]) count_brick(band, decoded, b, options.iso, scratch.local(), counts[b]);
+  }, 0.0, 0.3);
 
   SurfaceResult r;
-  for (const BrickOut& o : outs) r.extra_vertices += o.extra;
-  const MergeOffsets m = merge_offsets(outs, r, "marching_cubes");
-  auto remap = [&](std::uint32_t owner, int slot) {
-    const BrickOut& o = outs[owner];
-    return slot < kEdgeSlots ? m.vertex[owner] + o.owned.rank(slot)
-                             : m.vertex[owner] + o.edge_vertices + std::uint32_t(slot - kEdgeSlots);
-  };
-  copy_merged(outs, m, remap, r);
+  Bases at{std::vector<std::uint32_t>(nb + 1, 0), std::vector<std::uint64_t>(nb + 1, 0)};
+  std::uint64_t vertices = 0;
+  for (std::uint32_t b = 0; b < nb; ++b) {
+    at.vertex[b] = std::uint32_t(vertices);
+    vertices += std::uint64_t(counts[b].edge_vertices) + counts[b].centres;
+    if (vertices >= 0xffffffffull) throw Error(ErrorCode::LimitExceeded, "marching_cubes", "more than 2^32 - 1 vertices");
+    at.triangle[b + 1] = at.triangle[b] + counts[b].triangles;
+    r.extra_vertices += counts[b].centres;
+    r.cells_with_surface += counts[b].cells;
+  }
+  at.vertex[nb] = std::uint32_t(vertices);
+  size_result(r, vertices, at.triangle[nb]);
+  for_brick_batches(nb, options.progress, "marching_cubes", [&](std::uint32_t b) {
+    if (decoded.work[b]) write_brick(band, decoded, b, options.iso, counts, at, scratch.local(), r);
+  }, 0.3, 1.0);
   r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return r;
 }

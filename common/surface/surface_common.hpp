@@ -53,12 +53,15 @@ struct ValidCells {
   // Per cell row (y, z) in [-1, 8)^2: valid cells and valid cells crossing iso (bit x + kHalo).
   std::array<std::uint32_t, kN * kN> valid_rows{}, mixed_rows{};
   int mixed_cells = 0;  // cells in [0, 8)^3 that are valid and cross iso
-  void compute(const CellTile& t, double iso = 0.0) {
-    mixed_cells = 0;
-    active_rows = t.active_rows;
-    // double(v) < iso  <=>  v < below, the smallest float not below iso.
+  // double(v) < iso  <=>  v < float_below(iso), the smallest float not below iso.
+  static float float_below(double iso) {
     float below = float(iso);
     if (double(below) < iso) below = std::nextafter(below, std::numeric_limits<float>::infinity());
+    return below;
+  }
+  void compute(const CellTile& t, double iso = 0.0) {
+    active_rows = t.active_rows;
+    const float below = float_below(iso);
     constexpr std::uint32_t kRowBits = (1u << CellTile::kDim) - 1;
     for (int r = 0; r < CellTile::kDim * CellTile::kDim; ++r) {
       const float* v = &t.values[std::size_t(r) * CellTile::kDim];
@@ -73,6 +76,11 @@ struct ValidCells {
 #endif
       inside_rows[r] = ins;
     }
+    compute_cells();
+  }
+  // The cell rows from active_rows and inside_rows (filled by the caller).
+  void compute_cells() {
+    mixed_cells = 0;
     constexpr std::uint32_t kCellBits = ((1u << kN) - 1) << (kH - 1);  // x in [-1, 8)
     for (int z = -1; z < kBrickDim; ++z)
       for (int y = -1; y < kBrickDim; ++y) {
@@ -109,6 +117,25 @@ struct ValidCells {
     c[0] = act & (act >> 1) & (ins ^ (ins >> 1));
     for (int a = 1; a < 3; ++a) c[a] = act & active_rows[nb[a]] & (ins ^ inside_rows[nb[a]]);
     for (int a = 0; a < 3; ++a) c[a] = (c[a] >> (kH - 1)) & 0x3ffu;
+  }
+  // The grid edges from (x, y, z), x in [0, 8), y, z in [0, 8), that cross iso and belong to
+  // a contoured cell (crossing_edges and edge_used), as 24 bits: bit 3 x + a (slot order).
+  std::uint32_t owned_edges(int y, int z) const {
+    std::uint32_t c[3];
+    crossing_edges(y, z, c);
+    auto vr = [&](int yy, int zz) { return valid_rows[std::size_t((yy + 1) + kN * (zz + 1))]; };
+    const std::uint32_t v = vr(y, z), vy = vr(y - 1, z), vz = vr(y, z - 1), vyz = vr(y - 1, z - 1);
+    const std::uint32_t m1 = v | vz, m2 = v | vy;
+    const std::uint32_t used[3] = {v | vy | vz | vyz, m1 | (m1 << 1), m2 | (m2 << 1)};  // bit x + kH
+    std::uint32_t out = 0;
+    for (int a = 0; a < 3; ++a) out |= spread3((((c[a] & used[a]) >> kH) & 0xffu)) << a;
+    return out;
+  }
+  // Bit x of m (8 bits) moved to bit 3 x.
+  static std::uint32_t spread3(std::uint32_t m) {
+    std::uint32_t out = 0;
+    for (; m != 0; m &= m - 1) out |= 1u << (3 * std::countr_zero(m));
+    return out;
   }
   // Bits of crossing_edges for x in [lo, hi).
   static constexpr std::uint32_t x_bits(int lo, int hi) { return ((1u << (hi + 1)) - 1u) & ~((1u << (lo + 1)) - 1u); }
@@ -163,6 +190,12 @@ struct SlotBits {
   std::array<std::uint64_t, kWords> words{};
   std::array<std::uint32_t, kWords> base{};
   void set(int s) { words[s >> 6] |= std::uint64_t{1} << (s & 63); }
+  // Sets the slots [s, s + 32) where bits has a bit (bit i: slot s + i).
+  void set_bits(int s, std::uint32_t bits) {
+    const int w = s >> 6, o = s & 63;
+    words[w] |= std::uint64_t{bits} << o;
+    if (o > 32 && w + 1 < kWords) words[w + 1] |= std::uint64_t{bits} >> (64 - o);
+  }
   bool test(int s) const { return (words[s >> 6] >> (s & 63)) & 1u; }
   void finish() {
     std::uint32_t acc = 0;
@@ -335,10 +368,17 @@ Vec3d begin_brick(const NarrowBand& band, std::uint32_t b, double iso, CellTile&
 // lies in it, so it has work only when the active values of itself and its 7 upper neighbours
 // (+x, +y, +z and their combinations) lie on both sides of iso. One pass over the values.
 std::vector<std::uint8_t> bricks_with_crossings(const NarrowBand& band, double iso);
+// The same from each brick's sides (bit 0: an active value below iso, bit 1: one not below).
+std::vector<std::uint8_t> bricks_with_crossings(const NarrowBand& band, std::span<const std::uint8_t> sides);
 
-// f(brick) for every brick: TBB inside batches, progress.step between batches (serial).
+// f(brick) for every brick: TBB inside batches, progress.step between batches (serial), the
+// fraction running from `from` to `to` (a pass of a multi-pass operation reports its share).
 void for_brick_batches(std::uint32_t bricks, const ProgressHook& progress, std::string_view stage,
-                       const std::function<void(std::uint32_t)>& f);
+                       const std::function<void(std::uint32_t)>& f, double from = 0.0, double to = 1.0);
+
+// Sizes the result's vertex, normal and triangle arrays (empty before) side by side: sizing
+// zero-fills and first-touches tens of MB, huge pages advised.
+void size_result(SurfaceResult& r, std::size_t vertices, std::size_t triangles);
 
 // Vertex keys of the per-brick outputs: the owning brick as its slot in the emitting brick's
 // 3x3x3 neighbourhood (Neighborhood::slot, 5 bits) and the vertex slot in that brick.
@@ -383,10 +423,7 @@ MergeOffsets merge_offsets(std::vector<Out>& outs, SurfaceResult& r, std::string
     r.cells_with_surface += outs[b].cells;
   }
   m.vertex[nb] = std::uint32_t(total);
-  // Sizing zero-fills and first-touches the arrays (tens of MB): the three side by side.
-  tbb::parallel_invoke([&] { resize_with_huge_pages(r.mesh.vertices, total); },
-                       [&] { resize_with_huge_pages(r.normals, total); },
-                       [&] { resize_with_huge_pages(r.mesh.triangles, m.triangle[nb]); });
+  size_result(r, total, m.triangle[nb]);
   return m;
 }
 
