@@ -75,13 +75,26 @@ Neighborhood brick_star(const NarrowBand& band, std::uint32_t brick) {
 void decode_brick(const NarrowBand& band, std::uint32_t brick, std::span<float, kBrickVoxels> out) {
   const Brick& br = band.bricks()[brick];
   const float bg = band.background();
-  if (br.signs == kSignsAllOutside || br.signs == kSignsAllInside) {
-    std::fill(out.begin(), out.end(), br.signs == kSignsAllInside ? -bg : bg);
-  } else {
-    for (int n = 0; n < kBrickVoxels; ++n) out[n] = band.stored_inside(br, n) ? -bg : bg;
-  }
+  const float sign_value[2] = {bg, -bg};  // by inside bit
   const float* v = band.values().data() + br.value_offset;
-  br.active.for_each_set([&](int n) { out[n] = *v++; });
+  // A z-slice (64 voxels, one word of each mask) at a time: the stored signs branch-free, then
+  // the active values a row (8 voxels, one byte) at a time, a full row in one copy.
+  for (int w = 0; w < 8; ++w) {
+    float* o = out.data() + 64 * w;
+    const std::uint64_t inside = band.stored_inside_word(br, w), active = br.active.words[std::size_t(w)];
+    if (inside == 0 || inside == ~std::uint64_t{0}) std::fill_n(o, 64, sign_value[inside & 1]);
+    else
+      for (int i = 0; i < 64; ++i) o[i] = sign_value[(inside >> i) & 1];
+    for (int r = 0; r < 8; ++r) {
+      const std::uint32_t row = std::uint32_t(active >> (8 * r)) & 0xffu;
+      if (row == 0xffu) {
+        std::memcpy(o + 8 * r, v, 8 * sizeof(float));
+        v += 8;
+        continue;
+      }
+      for (std::uint32_t m = row; m != 0; m &= m - 1) o[8 * r + std::countr_zero(m)] = *v++;
+    }
+  }
 }
 
 void gather_tile(const NarrowBand& band, std::uint32_t brick, int halo, std::span<float> out) {
@@ -258,10 +271,10 @@ NeighborSigns resolve_neighbor_signs(const NarrowBand& band, const Neighborhood&
 DecodedBricks decode_bricks(const NarrowBand& band) {
   DecodedBricks out;
   out.size = band.brick_count() * std::size_t(kBrickVoxels);
-  // Not value-initialised: every entry is written below, in parallel, which is also where
-  // fresh pages fault in (a zeroing pass would touch them all on one thread first).
+  // Not value-initialised: every entry is written below, in parallel; the pages are faulted
+  // in first by one call (prefault_for_write), not by a trap per page.
   out.data.reset(new float[std::max<std::size_t>(out.size, 1)]);
-  if (out.size * sizeof(float) >= (std::size_t{2} << 21)) advise_huge_pages(out.data.get(), out.size * sizeof(float));
+  prefault_for_write(out.data.get(), out.size * sizeof(float));
   tbb::parallel_for(tbb::blocked_range<std::uint32_t>(0, std::uint32_t(band.brick_count()), 64),
                     [&](const tbb::blocked_range<std::uint32_t>& r) {
                       for (std::uint32_t b = r.begin(); b != r.end(); ++b)

@@ -336,7 +336,7 @@ class OutputArena {
     if (chunks_.empty() || used_ + bytes > size_) {
       size_ = std::max(kChunkBytes, (bytes + kAlign - 1) & ~(kAlign - 1));
       chunks_.push_back(static_cast<std::byte*>(::operator new[](size_, std::align_val_t(kAlign))));
-      advise_huge_pages(chunks_.back(), size_);
+      prefault_for_write(chunks_.back(), size_);
       used_ = 0;
     }
     std::byte* at = chunks_.back() + used_;
