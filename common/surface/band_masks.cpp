@@ -1,5 +1,7 @@
 #include "surface/band_masks.hpp"
 
+#include <array>
+
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
@@ -55,28 +57,36 @@ DecodedBand decode_band(const NarrowBand& band, double iso) {
 void cell_masks(const NarrowBand& band, const DecodedBand& decoded, const Neighborhood& around,
                 const NeighborSigns& signs, ValidCells& valid) {
   constexpr int kH = CellTile::kHalo;
+  // Each neighbour's mask words (an unallocated one: none active, all on its sign's side).
+  static constexpr std::array<std::uint64_t, 8> kNone{}, kAll{~0ull, ~0ull, ~0ull, ~0ull, ~0ull, ~0ull, ~0ull, ~0ull};
+  const std::uint64_t* active_words[27];
+  const std::uint64_t* inside_words[27];
+  for (int k = 0; k < 27; ++k) {
+    const std::uint32_t nb = around[std::size_t(k)];
+    if (nb == kNoBrick) {
+      active_words[k] = kNone.data();
+      inside_words[k] = ((signs.inside >> k) & 1u) ? kAll.data() : kNone.data();
+    } else {
+      active_words[k] = band.bricks()[nb].active.words.data();
+      inside_words[k] = decoded.inside_words(nb).data();
+    }
+  }
   for (int z = -kH; z < CellTile::kDim - kH; ++z) {
     const int dz = z < 0 ? -1 : (z >= kBrickDim ? 1 : 0), lz = z - kBrickDim * dz;
     for (int y = -kH; y < CellTile::kDim - kH; ++y) {
       const int dy = y < 0 ? -1 : (y >= kBrickDim ? 1 : 0), shift = 8 * (y - kBrickDim * dy);
-      std::uint32_t part_active[3], part_inside[3];  // the row's 8 voxels in each x neighbour
-      for (int dx = -1; dx <= 1; ++dx) {
-        const int k = Neighborhood::slot(dx, dy, dz);
-        const std::uint32_t nb = around[std::size_t(k)];
-        if (nb == kNoBrick) {
-          part_active[dx + 1] = 0;
-          part_inside[dx + 1] = ((signs.inside >> k) & 1u) ? 0xffu : 0u;
-        } else {
-          part_active[dx + 1] = std::uint32_t(band.bricks()[nb].active.words[std::size_t(lz)] >> shift) & 0xffu;
-          part_inside[dx + 1] = std::uint32_t(decoded.inside_words(nb)[std::size_t(lz)] >> shift) & 0xffu;
-        }
-      }
-      // Tile bit x + kHalo: x = -1 from the lower neighbour's last voxel, [0, 8) from the brick,
-      // 8 and 9 from the upper neighbour's first two.
-      auto join = [](const std::uint32_t* p) { return (p[0] >> 7) | (p[1] << 1) | ((p[2] & 3u) << 9); };
+      const int k = Neighborhood::slot(0, dy, dz);  // the x neighbours are k - 1 and k + 1
+      // The row's 8 voxels in each x neighbour: tile bit x + kHalo takes x = -1 from the lower
+      // neighbour's last voxel, [0, 8) from the brick, 8 and 9 from the upper neighbour's first two.
+      auto row = [&](const std::uint64_t* const* words) {
+        const std::uint32_t lower = std::uint32_t(words[k - 1][lz] >> shift) & 0xffu;
+        const std::uint32_t mid = std::uint32_t(words[k][lz] >> shift) & 0xffu;
+        const std::uint32_t upper = std::uint32_t(words[k + 1][lz] >> shift) & 0xffu;
+        return (lower >> 7) | (mid << 1) | ((upper & 3u) << 9);
+      };
       const int r = ValidCells::row(y, z);
-      valid.active_rows[std::size_t(r)] = join(part_active);
-      valid.inside_rows[std::size_t(r)] = join(part_inside);
+      valid.active_rows[std::size_t(r)] = row(active_words);
+      valid.inside_rows[std::size_t(r)] = row(inside_words);
     }
   }
   valid.compute_cells();

@@ -38,11 +38,13 @@ struct BrickCount {
   NeighborSigns signs{};
 };
 
-// Per-thread scratch: the tile, its cell classes and edge crossings.
+// Per-thread scratch: the tile, its cell classes, edge crossings and the crossing edges'
+// global vertex indices (tile index * 3 + axis).
 struct Scratch {
   CellTile tile;
   ValidCells valid;
   EdgeCrossings edges;
+  std::vector<std::uint32_t> vertex_of_edge = std::vector<std::uint32_t>(3 * CellTile::kSize);
 };
 
 // The grid edges from voxels in [0, 8)^3 that cross iso and belong to a contoured cell, in slot
@@ -132,7 +134,14 @@ void write_brick(const NarrowBand& band, const DecodedBand& decoded, std::uint32
   const Coord base = brick_origin(band.bricks()[b].coord);
   const Vec3d corner = band.origin() + Vec3d{double(base.x), double(base.y), double(base.z)} * band.voxel_size();
   const double h = band.voxel_size();
-  s.edges.compute(t, s.valid, iso, 0);
+  // Each crossing edge's vertex index once (the cells' loops reference an edge up to 4 times):
+  // its owner brick's first vertex plus the edge's rank among the owner's owned slots. Both
+  // ends of a crossing edge are active, so the owner is allocated.
+  s.edges.compute(t, s.valid, iso, 0, [&](int x, int y, int z, int a, int p) {
+    const std::uint32_t owner = t.around[std::size_t(Neighborhood::slot(x >> 3, y >> 3, z >> 3))];
+    s.vertex_of_edge[std::size_t(3 * p + a)] =
+        at.vertex[owner] + counts[owner].owned.rank(3 * local_index(x & 7, y & 7, z & 7) + a);
+  });
   Vec3d* vertex = r.mesh.vertices.data() + at.vertex[b];
   Vec3f* normal = r.normals.data() + at.vertex[b];
   // The two passes enumerate the same data the same way; a difference is a bug, not input,
@@ -159,8 +168,7 @@ void write_brick(const NarrowBand& band, const DecodedBand& decoded, std::uint32
       for (int i = 0; i < n; ++i) {
         const int c = cell::edge_lower_corner(edges[i]);
         const int ex = x + (c & 1), ey = y + ((c >> 1) & 1), ez = z + ((c >> 2) & 1);
-        const std::uint32_t owner = t.around[std::size_t(Neighborhood::slot(ex >> 3, ey >> 3, ez >> 3))];
-        index[i] = at.vertex[owner] + counts[owner].owned.rank(3 * local_index(ex & 7, ey & 7, ez & 7) + (edges[i] >> 2));
+        index[i] = s.vertex_of_edge[std::size_t(3 * CellTile::index(ex, ey, ez) + (edges[i] >> 2))];
         if (n > 3) pos[i] = s.edges.point(ex, ey, ez, edges[i] >> 2);
       }
       if (n == 3) {

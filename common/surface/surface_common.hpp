@@ -159,6 +159,11 @@ struct ValidCells {
 struct EdgeCrossings {
   std::vector<double> s = std::vector<double>(3 * CellTile::kSize);
   void compute(const CellTile& t, const ValidCells& v, double iso, int lo) {
+    compute(t, v, iso, lo, [](int, int, int, int, int) {});
+  }
+  // The same, calling also(x, y, z, a, p) for each crossing edge (p: tile index of (x, y, z)).
+  template <typename Also>
+  void compute(const CellTile& t, const ValidCells& v, double iso, int lo, Also&& also) {
     for (int z = lo; z <= kBrickDim; ++z)
       for (int y = lo; y <= kBrickDim; ++y) {
         std::uint32_t cr[3];
@@ -171,6 +176,7 @@ struct EdgeCrossings {
             if (!((cr[a] >> (x + 1)) & 1u)) continue;
             const double ap = double(t.values[p]) - iso, aq = double(t.values[p + kTileStride[a]]) - iso;
             s[std::size_t(3 * p + a)] = ap / (ap - aq);
+            also(x, y, z, a, p);
           }
         }
       }
