@@ -5,12 +5,12 @@
 #include <bit>
 #include <chrono>
 #include <cmath>
-#include <span>
 #include <memory>
 #include <new>
+#include <span>
 #include <stdexcept>
-#include <type_traits>
 #include <string>
+#include <type_traits>
 #include <vector>
 
 #include <tbb/enumerable_thread_specific.h>

@@ -15,10 +15,13 @@
 //   centroid instead (counted in extra_vertices), so that no diagonal is shared by two cells.
 //   The mesh is watertight, manifold and consistently oriented wherever the iso-surface lies
 //   inside the contoured cells.
-// Units: world (the band's frame). Cost: O(bricks * 11^3) for the bricks whose cells can
-//   cross iso (others are skipped after one pass over the values) plus O(output).
-// Threading: TBB over bricks; per-brick buffers merged in brick order, so vertex and triangle
-//   arrays are identical for any thread count.
+// Units: world (the band's frame). Cost: one pass decoding every brick (2 KiB each) with its
+//   inside mask at iso; a counting pass over the bricks whose cells can cross iso, from the
+//   masks (O(11^2) bit rows per brick; values only for cells with an ambiguous face); a
+//   writing pass that gathers their 11^3 tiles and writes O(output) straight into the result
+//   at the prefix sums of the counts. Memory: ~2.5 KiB per brick besides the output.
+// Threading: TBB over bricks in both passes; outputs sit in brick order, so vertex and
+//   triangle arrays are identical for any thread count.
 // Errors: Error{InvalidArgument} when |iso| >= background() or iso is not finite;
 //   Error{Cancelled} through options.progress (checked between brick batches).
 #pragma once
