@@ -4,6 +4,10 @@
 #include <array>
 #include <bit>
 #include <cstring>
+
+#if defined(__x86_64__)
+#include <immintrin.h>
+#endif
 #include <string>
 
 #include <tbb/blocked_range.h>
@@ -72,21 +76,22 @@ Neighborhood brick_star(const NarrowBand& band, std::uint32_t brick) {
   return n;
 }
 
-void decode_brick(const NarrowBand& band, std::uint32_t brick, std::span<float, kBrickVoxels> out) {
-  const Brick& br = band.bricks()[brick];
-  const float bg = band.background();
+namespace {
+
+// One brick's 512 values from its packed active values and its active and inside words:
+// inactive voxels +-bg by their stored sign.
+void decode_words_portable(const float* v, const std::uint64_t* active, const std::uint64_t* inside, float bg,
+                           float* out) {
   const float sign_value[2] = {bg, -bg};  // by inside bit
-  const float* v = band.values().data() + br.value_offset;
-  // A z-slice (64 voxels, one word of each mask) at a time: the stored signs branch-free, then
-  // the active values a row (8 voxels, one byte) at a time, a full row in one copy.
+  // A z-slice (64 voxels, one word of each mask) at a time: the signs branch-free, then the
+  // active values a row (8 voxels, one byte) at a time, a full row in one copy.
   for (int w = 0; w < 8; ++w) {
-    float* o = out.data() + 64 * w;
-    const std::uint64_t inside = band.stored_inside_word(br, w), active = br.active.words[std::size_t(w)];
-    if (inside == 0 || inside == ~std::uint64_t{0}) std::fill_n(o, 64, sign_value[inside & 1]);
+    float* o = out + 64 * w;
+    if (inside[w] == 0 || inside[w] == ~std::uint64_t{0}) std::fill_n(o, 64, sign_value[inside[w] & 1]);
     else
-      for (int i = 0; i < 64; ++i) o[i] = sign_value[(inside >> i) & 1];
+      for (int i = 0; i < 64; ++i) o[i] = sign_value[(inside[w] >> i) & 1];
     for (int r = 0; r < 8; ++r) {
-      const std::uint32_t row = std::uint32_t(active >> (8 * r)) & 0xffu;
+      const std::uint32_t row = std::uint32_t(active[w] >> (8 * r)) & 0xffu;
       if (row == 0xffu) {
         std::memcpy(o + 8 * r, v, 8 * sizeof(float));
         v += 8;
@@ -95,6 +100,48 @@ void decode_brick(const NarrowBand& band, std::uint32_t brick, std::span<float, 
       for (std::uint32_t m = row; m != 0; m &= m - 1) o[8 * r + std::countr_zero(m)] = *v++;
     }
   }
+}
+
+#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__)
+#define LEVELSET_DECODE_AVX512 1
+// The same, 16 voxels per instruction: the sign blend, then an expanding load puts the next
+// popcount(mask) packed values into the active lanes (masked-off lanes read no memory).
+__attribute__((target("avx512f"))) void decode_words_avx512(const float* v, const std::uint64_t* active,
+                                                             const std::uint64_t* inside, float bg, float* out) {
+  const __m512 plus = _mm512_set1_ps(bg), minus = _mm512_set1_ps(-bg);
+  for (int w = 0; w < 8; ++w)
+    for (int q = 0; q < 4; ++q) {
+      const __mmask16 act = __mmask16(active[w] >> (16 * q)), in = __mmask16(inside[w] >> (16 * q));
+      const __m512 signs = _mm512_mask_blend_ps(in, plus, minus);
+      _mm512_storeu_ps(out + 64 * w + 16 * q, _mm512_mask_expandloadu_ps(signs, act, v));
+      v += std::popcount(unsigned(act));
+    }
+}
+#endif
+
+}  // namespace
+
+void decode_brick_portable(const NarrowBand& band, std::uint32_t brick, std::span<float, kBrickVoxels> out) {
+  const Brick& br = band.bricks()[brick];
+  std::uint64_t inside[8];
+  for (int w = 0; w < 8; ++w) inside[w] = band.stored_inside_word(br, w);
+  decode_words_portable(band.values().data() + br.value_offset, br.active.words.data(), inside, band.background(),
+                        out.data());
+}
+
+void decode_brick(const NarrowBand& band, std::uint32_t brick, std::span<float, kBrickVoxels> out) {
+  const Brick& br = band.bricks()[brick];
+  std::uint64_t inside[8];
+  for (int w = 0; w < 8; ++w) inside[w] = band.stored_inside_word(br, w);
+  const float* v = band.values().data() + br.value_offset;
+#if defined(LEVELSET_DECODE_AVX512)
+  static const bool avx512 = __builtin_cpu_supports("avx512f");
+  if (avx512) {
+    decode_words_avx512(v, br.active.words.data(), inside, band.background(), out.data());
+    return;
+  }
+#endif
+  decode_words_portable(v, br.active.words.data(), inside, band.background(), out.data());
 }
 
 void gather_tile(const NarrowBand& band, std::uint32_t brick, int halo, std::span<float> out) {

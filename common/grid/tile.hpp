@@ -59,8 +59,11 @@ void gather_box(const NarrowBand& band, std::uint32_t brick, int lo, int hi, std
 void gather_box(const NarrowBand& band, const Neighborhood& around, int lo, int hi, std::span<float> out,
                 std::span<std::uint32_t> active_rows);
 
-// Dense 512 values of one brick (halo 0) into out[local_index].
+// Dense 512 values of one brick (halo 0) into out[local_index]. With AVX-512 (checked when the
+// program loads) 16 voxels per expanding load; decode_brick_portable is the plain form, for
+// tests on such machines.
 void decode_brick(const NarrowBand& band, std::uint32_t brick, std::span<float, kBrickVoxels> out);
+void decode_brick_portable(const NarrowBand& band, std::uint32_t brick, std::span<float, kBrickVoxels> out);
 
 // Every brick decoded once (decode_brick; 512 values per brick, in brick order; TBB), for a
 // pass that gathers a box around every brick: a box then copies rows from the decoded bricks
