@@ -14,7 +14,6 @@
 
 #include "core/error.hpp"
 #include "core/text.hpp"
-#include "core/uninitialized_vector.hpp"
 #include "distance/redistance.hpp"
 #include "evolve/band_tracking.hpp"
 #include "evolve/evolution_operator.hpp"
@@ -181,23 +180,14 @@ Advanced advance(NarrowBand& cur, const OperatorOutput& op, const OperatorSetup&
 // The edge layer from the new interior values (EdgeStencil), on its own side only.
 void extrapolate_edge_layer(const NarrowBand& cur, const OperatorOutput& op, std::vector<float>& next) {
   const double h = cur.voxel_size();
-  // All stencils read the new interior values before any edge value is written (a stencil may
-  // read a voxel another brick's stencil writes): results first, in one array at each brick's
-  // offset (no per-brick vectors), then written.
-  const std::size_t nb = op.edge_stencils.size();
-  std::vector<std::size_t> first(nb + 1, 0);
-  for (std::size_t b = 0; b < nb; ++b) first[b + 1] = first[b] + op.edge_stencils[b].size();
-  UninitializedVector<float> value(first[nb]);
-  UninitializedVector<std::uint8_t> keep(first[nb]);
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, nb, 64), [&](const tbb::blocked_range<std::size_t>& r) {
+  std::vector<std::vector<std::pair<std::uint32_t, float>>> edge_values(op.edge_stencils.size());
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, op.edge_stencils.size(), 64), [&](const tbb::blocked_range<std::size_t>& r) {
     for (std::size_t b = r.begin(); b != r.end(); ++b)
-      for (std::size_t i = 0; i < op.edge_stencils[b].size(); ++i) {
-        const EdgeStencil& e = op.edge_stencils[b][i];
+      for (const EdgeStencil& e : op.edge_stencils[b]) {
         double v = 0;
         for (int k = 0; k < e.count; ++k) v += double(e.coef[std::size_t(k)]) * double(next[e.source[std::size_t(k)]]);
         const bool inside = cur.values()[e.target] < 0.0f;
-        keep[first[b] + i] = inside == (v < 0.0);
-        if (!keep[first[b] + i]) continue;
+        if (inside != (v < 0.0)) continue;
         double lo = 0.0, hi = std::numeric_limits<double>::infinity();
         for (int k = 0; k < e.neighbors; ++k) {
           const double un = next[e.neighbor[std::size_t(k)]];
@@ -206,13 +196,12 @@ void extrapolate_edge_layer(const NarrowBand& cur, const OperatorOutput& op, std
           hi = std::min(hi, std::abs(un) + h);
         }
         const double mag = std::clamp(std::abs(v), lo, std::max(lo, hi));
-        value[first[b] + i] = float(inside ? -mag : mag);
+        edge_values[b].push_back({e.target, float(inside ? -mag : mag)});
       }
   });
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, nb, 64), [&](const tbb::blocked_range<std::size_t>& r) {
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, edge_values.size(), 64), [&](const tbb::blocked_range<std::size_t>& r) {
     for (std::size_t b = r.begin(); b != r.end(); ++b)
-      for (std::size_t i = 0; i < op.edge_stencils[b].size(); ++i)
-        if (keep[first[b] + i]) next[op.edge_stencils[b][i].target] = value[first[b] + i];
+      for (const auto& [i, v] : edge_values[b]) next[i] = v;
   });
 }
 
