@@ -383,7 +383,8 @@ void for_brick_batches(std::uint32_t bricks, const ProgressHook& progress, std::
                        const std::function<void(std::uint32_t)>& f, double from = 0.0, double to = 1.0);
 
 // Sizes the result's vertex, normal and triangle arrays (empty before) side by side: sizing
-// zero-fills and first-touches tens of MB, huge pages advised.
+// zero-fills tens of MB, after their pages are faulted in by one call each
+// (resize_with_huge_pages).
 void size_result(SurfaceResult& r, std::size_t vertices, std::size_t triangles);
 
 // Vertex keys of the per-brick outputs: the owning brick as its slot in the emitting brick's
