@@ -177,13 +177,14 @@ Advanced advance(NarrowBand& cur, const OperatorOutput& op, const OperatorSetup&
   return {std::move(next), mine, finite, dt};
 }
 
-// The edge layer from the new interior values (EdgeStencil), on its own side only.
-void extrapolate_edge_layer(const NarrowBand& cur, const OperatorOutput& op, std::vector<float>& next) {
+// The edge layer from the new interior values (EdgeStencil), on its own side only: every
+// stencil's value from `next` first (into the stencil), then all are written.
+void extrapolate_edge_layer(const NarrowBand& cur, OperatorOutput& op, std::vector<float>& next) {
   const double h = cur.voxel_size();
-  std::vector<std::vector<std::pair<std::uint32_t, float>>> edge_values(op.edge_stencils.size());
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, op.edge_stencils.size(), 64), [&](const tbb::blocked_range<std::size_t>& r) {
     for (std::size_t b = r.begin(); b != r.end(); ++b)
-      for (const EdgeStencil& e : op.edge_stencils[b]) {
+      for (EdgeStencil& e : op.edge_stencils[b]) {
+        e.value = next[e.target];
         double v = 0;
         for (int k = 0; k < e.count; ++k) v += double(e.coef[std::size_t(k)]) * double(next[e.source[std::size_t(k)]]);
         const bool inside = cur.values()[e.target] < 0.0f;
@@ -196,12 +197,12 @@ void extrapolate_edge_layer(const NarrowBand& cur, const OperatorOutput& op, std
           hi = std::min(hi, std::abs(un) + h);
         }
         const double mag = std::clamp(std::abs(v), lo, std::max(lo, hi));
-        edge_values[b].push_back({e.target, float(inside ? -mag : mag)});
+        e.value = float(inside ? -mag : mag);
       }
   });
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, edge_values.size(), 64), [&](const tbb::blocked_range<std::size_t>& r) {
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, op.edge_stencils.size(), 64), [&](const tbb::blocked_range<std::size_t>& r) {
     for (std::size_t b = r.begin(); b != r.end(); ++b)
-      for (const auto& [i, v] : edge_values[b]) next[i] = v;
+      for (const EdgeStencil& e : op.edge_stencils[b]) next[e.target] = e.value;
   });
 }
 

@@ -39,6 +39,9 @@ struct EdgeStencil {
   // clamped to the range they allow (a polynomial through a kink could leave it).
   std::uint8_t neighbors = 0;
   std::array<std::uint32_t, 6> neighbor{};
+  // The new value of target, written by the step's extrapolation before any target is
+  // (sources and neighbours may be edge voxels themselves: all read the step's values).
+  float value = 0;
 };
 
 // CPU seconds summed over threads, per phase of the spatial operator.
