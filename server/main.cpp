@@ -13,6 +13,7 @@
 #include "commands/commands.hpp"
 #include "core/error.hpp"
 #include "core/file_io.hpp"
+#include "core/malloc_policy.hpp"
 #include "core/memory_budget.hpp"
 #include "core/text.hpp"
 #include "commands/output_check.hpp"
@@ -22,6 +23,7 @@
 using levelset::cli::add_common_options;
 
 int main(int argc, char** argv) {
+  levelset::keep_freed_memory();  // steps and requests reuse freed buffers (malloc_policy.hpp)
   CLI::App app{"levelsetd: narrow-band level-set computation (batch subcommands; daemon to come)"};
   app.set_version_flag("--version", std::string("levelsetd ") + LEVELSET_VERSION);
   app.require_subcommand(1);

@@ -33,11 +33,16 @@
 #include <tbb/parallel_for.h>
 
 #include "core/error.hpp"
+#include "core/malloc_policy.hpp"
 #include "grid/band_builder.hpp"
 #include "grid/narrow_band.hpp"
 #include "io/triangle_mesh.hpp"
 
 namespace levelset::bench {
+
+// Every bench runs with levelsetd's malloc settings (core/malloc_policy.hpp), set before main
+// and shared by both sides of each comparison: freed buffers stay in the process.
+inline const bool kKeepsFreedMemory = keep_freed_memory();
 
 inline bool is_quick(int argc, char** argv) { return argc > 1 && std::strcmp(argv[1], "--quick") == 0; }
 
