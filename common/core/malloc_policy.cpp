@@ -8,9 +8,8 @@ namespace levelset {
 
 bool keep_freed_memory(std::size_t keep_bytes) {
 #if defined(__GLIBC__)
-  constexpr int kLargestMmapThreshold = 32 << 20;  // glibc refuses more (HEAP_MAX_SIZE / 2)
   const int keep = keep_bytes > std::size_t(0x7fffffff) ? 0x7fffffff : int(keep_bytes);
-  return mallopt(M_MMAP_THRESHOLD, kLargestMmapThreshold) == 1 && mallopt(M_TRIM_THRESHOLD, keep) == 1;
+  return mallopt(M_MMAP_MAX, 0) == 1 && mallopt(M_TRIM_THRESHOLD, keep) == 1;
 #else
   (void)keep_bytes;
   return false;
