@@ -1,5 +1,8 @@
 #include "core/malloc_policy.hpp"
 
+#include <cstdlib>
+#include <cstring>
+
 #if defined(__GLIBC__)
 #include <malloc.h>
 #endif
@@ -7,6 +10,8 @@
 namespace levelset {
 
 bool keep_freed_memory(std::size_t keep_bytes) {
+  const char* off = std::getenv("LEVELSET_KEEP_FREED_MEMORY");
+  if (off != nullptr && std::strcmp(off, "0") == 0) return false;
 #if defined(__GLIBC__)
   const int keep = keep_bytes > std::size_t(0x7fffffff) ? 0x7fffffff : int(keep_bytes);
   return mallopt(M_MMAP_MAX, 0) == 1 && mallopt(M_TRIM_THRESHOLD, keep) == 1;

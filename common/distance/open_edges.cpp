@@ -1,30 +1,39 @@
 #include "distance/open_edges.hpp"
 
+#include <cstring>
 #include <numeric>
 
 #include <tbb/parallel_sort.h>
 
+#include "core/error.hpp"
+#include "core/index_hash_table.hpp"
+
 namespace levelset {
+
+namespace {
+
+// The bits of a coordinate with -0 read as +0 (they compare equal, so they must hash equal).
+std::uint64_t coordinate_bits(double v) {
+  if (v == 0.0) v = 0.0;
+  std::uint64_t b;
+  std::memcpy(&b, &v, sizeof b);
+  return b;
+}
+
+}  // namespace
 
 std::vector<std::uint32_t> weld_exact(std::span<const Vec3d> positions) {
   const std::size_t n = positions.size();
-  std::vector<std::uint32_t> order(n);
-  std::iota(order.begin(), order.end(), 0u);
-  auto less = [&](std::uint32_t a, std::uint32_t b) {
-    const Vec3d& p = positions[a];
-    const Vec3d& q = positions[b];
-    if (p.x != q.x) return p.x < q.x;
-    if (p.y != q.y) return p.y < q.y;
-    if (p.z != q.z) return p.z < q.z;
-    return a < b;
-  };
-  tbb::parallel_sort(order.begin(), order.end(), less);
+  if (n >= 0xffffffffu) throw Error(ErrorCode::LimitExceeded, "weld_exact", "2^32 - 1 or more vertices");
+  // In index order, each position maps to the first index holding it: the lowest. NaN
+  // coordinates equal nothing, so such a vertex stays on its own.
+  IndexHashTable table(n);
   std::vector<std::uint32_t> id(n);
-  for (std::size_t i = 0; i < n;) {
-    std::size_t j = i + 1;
-    while (j < n && positions[order[j]] == positions[order[i]]) ++j;
-    for (std::size_t k = i; k < j; ++k) id[order[k]] = order[i];  // lowest index: sorted by index
-    i = j;
+  for (std::uint32_t i = 0; i < n; ++i) {
+    const Vec3d& p = positions[i];
+    const std::uint64_t hash = coordinate_bits(p.x) ^ IndexHashTable::mix(coordinate_bits(p.y) + 0x9e3779b97f4a7c15ull) ^
+                               (IndexHashTable::mix(coordinate_bits(p.z)) << 1);
+    id[i] = table.find_or_insert(hash, i, [&](std::uint32_t j) { return positions[j] == p; });
   }
   return id;
 }

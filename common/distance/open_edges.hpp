@@ -4,7 +4,8 @@
 // weld_exact
 //   Input: positions. Output: per position the lowest index holding exactly the same
 //   coordinates (so split vertices along texture or normal seams share edges).
-//   Cost: O(V log V) (one parallel sort). Threading: TBB, deterministic. Errors: none.
+//   Cost: O(V) expected (one pass over a hash table of 2-4 slots per position). Threading:
+//   none. Errors: Error{LimitExceeded} for 2^32 - 1 or more positions.
 // open_edges
 //   Inputs: the mesh's triangles (indices), welded vertex ids (weld_exact of the positions the
 //   caller uses), and per triangle whether it counts (exactly degenerate triangles carry no

@@ -7,9 +7,8 @@
 #include <utility>
 #include <vector>
 
-#include <tbb/parallel_sort.h>
-
 #include "core/error.hpp"
+#include "core/huge_pages.hpp"
 #include "io/validate_mesh.hpp"
 #include "distance/open_edges.hpp"
 
@@ -43,12 +42,13 @@ bool degenerate(const TriangleMesh& mesh, const std::array<std::uint32_t, 3>& f)
 
 }  // namespace
 
-OrientResult orient_faces(const TriangleMesh& mesh, const OrientOptions& options) {
-  const std::size_t nf = mesh.triangles.size();
+OrientResult orient_faces(TriangleMesh input, const OrientOptions& options) {
+  const std::size_t nf = input.triangles.size();
   if (nf >= 0xffffffffu) throw Error(ErrorCode::LimitExceeded, "mesh", "2^32 or more faces");
-  validate_mesh(mesh);
+  validate_mesh(input);
   OrientResult result;
-  result.mesh = mesh;
+  result.mesh = std::move(input);
+  const TriangleMesh& mesh = result.mesh;  // read as given; the flips are applied at the end
   // Edges join faces through vertices at exactly equal positions (split seam vertices too).
   std::vector<std::uint32_t> id;
   if (options.welded) {
@@ -58,10 +58,12 @@ OrientResult orient_faces(const TriangleMesh& mesh, const OrientOptions& options
     id = weld_exact(mesh.vertices);
   }
 
-  // Edge uses of non-degenerate faces, grouped by undirected edge.
+  // Edge uses of non-degenerate faces, grouped by undirected edge: in (key, face, slot) order,
+  // by a counting sort on the lower vertex (uses are made in face and slot order, so each
+  // vertex's bucket is already in that order) and an insertion sort on the higher one within
+  // each bucket (a vertex's edges: a handful; a fan's apex is sorted).
   std::vector<bool> is_degenerate(nf);
-  std::vector<EdgeUse> uses;
-  uses.reserve(3 * nf);
+  std::vector<std::uint32_t> bucket(id.size() + 1, 0);
   for (std::size_t t = 0; t < nf; ++t) {
     const auto& f = mesh.triangles[t];
     is_degenerate[t] =
@@ -70,13 +72,32 @@ OrientResult orient_faces(const TriangleMesh& mesh, const OrientOptions& options
       ++result.degenerate_faces;
       continue;
     }
-    for (int k = 0; k < 3; ++k) {
-      const std::uint32_t a = id[f[k]], b = id[f[(k + 1) % 3]];
-      const std::uint64_t lo = a < b ? a : b, hi = a < b ? b : a;
-      uses.push_back({(lo << 32) | hi, std::uint32_t(t), std::uint8_t(k), a < b});
+    for (int k = 0; k < 3; ++k) ++bucket[std::min(id[f[k]], id[f[(k + 1) % 3]]) + 1];
+  }
+  for (std::size_t v = 0; v + 1 < bucket.size(); ++v) bucket[v + 1] += bucket[v];
+  std::vector<EdgeUse> uses;
+  resize_with_huge_pages(uses, bucket.back());
+  {
+    std::vector<std::uint32_t> fill(bucket.begin(), bucket.end() - 1);
+    for (std::size_t t = 0; t < nf; ++t) {
+      if (is_degenerate[t]) continue;
+      const auto& f = mesh.triangles[t];
+      for (int k = 0; k < 3; ++k) {
+        const std::uint32_t a = id[f[k]], b = id[f[(k + 1) % 3]];
+        const std::uint64_t lo = a < b ? a : b, hi = a < b ? b : a;
+        uses[fill[lo]++] = {(lo << 32) | hi, std::uint32_t(t), std::uint8_t(k), a < b};
+      }
     }
   }
-  tbb::parallel_sort(uses.begin(), uses.end());
+  for (std::size_t v = 0; v + 1 < bucket.size(); ++v) {
+    const std::uint32_t begin = bucket[v], end = bucket[v + 1];
+    if (end - begin > 32) {  // a fan's apex: its uses sorted like any (the order is total)
+      std::sort(uses.begin() + begin, uses.begin() + end);
+      continue;
+    }
+    for (std::uint32_t i = begin + 1; i < end; ++i)
+      for (std::uint32_t j = i; j > begin && uses[j] < uses[j - 1]; --j) std::swap(uses[j], uses[j - 1]);
+  }
   options.progress.step(0.4, "orient");
 
   // Manifold edges become links between their two faces (CSR, neighbours sorted by index).
@@ -95,7 +116,8 @@ OrientResult orient_faces(const TriangleMesh& mesh, const OrientOptions& options
     i = j;
   }
   for (std::size_t t = 0; t < nf; ++t) offsets[t + 1] += offsets[t];
-  std::vector<Link> links(offsets[nf]);
+  std::vector<Link> links;
+  resize_with_huge_pages(links, offsets[nf]);
   {
     std::vector<std::uint32_t> fill(offsets.begin(), offsets.end() - 1);
     for (const auto& [i, j] : pairs) {

@@ -17,9 +17,9 @@
 //   Degenerate faces (a repeated vertex or an exactly zero cross product) are kept as
 //   they are and neither propagate nor count in any component. A flip swaps a face's second
 //   and third index; vertices and face order are unchanged.
-// Cost: O(F log F + V log V) time (sorts of 3F edge records and of the vertices), O(F + V)
-//   memory.
-// Threading: the sorts are parallel (TBB); the result is identical for any thread count.
+// Cost: O(F + V) expected time (a counting sort of 3F edge records by their lower vertex, a
+//   hash table for the weld), O(F + V) memory.
+// Threading: none (it runs beside the closest point transform's scan).
 // Errors: Error{InvalidArgument} for vertex indices out of range, Error{NonFinite} for NaN or
 //   Inf vertices, Error{LimitExceeded} for 2^32 or more faces, Error{Cancelled} from the
 //   progress hook.
@@ -48,6 +48,7 @@ struct OrientResult {
   std::uint64_t inconsistent_edges = 0;  // manifold edges left inconsistent (non-orientable)
 };
 
-OrientResult orient_faces(const TriangleMesh& mesh, const OrientOptions& options);
+// The mesh is taken by value: pass a temporary (or std::move) to orient it without a copy.
+OrientResult orient_faces(TriangleMesh mesh, const OrientOptions& options);
 
 }  // namespace levelset

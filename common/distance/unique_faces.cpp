@@ -2,8 +2,7 @@
 
 #include <algorithm>
 
-#include <tbb/parallel_sort.h>
-
+#include "core/index_hash_table.hpp"
 #include "distance/open_edges.hpp"
 
 namespace levelset {
@@ -19,8 +18,12 @@ UniqueFacesResult unique_faces(const TriangleMesh& mesh) {
     std::uint32_t face;
     int orientation;  // +1 / -1: the parity of the face's vertex order against the sorted one
   };
+  // Faces grouped by their welded vertex set in one pass (the first face of each set is its
+  // representative); only the sets met more than once are sorted below.
   std::vector<Key> keys;
   keys.reserve(mesh.triangles.size());
+  IndexHashTable table(mesh.triangles.size());
+  std::vector<std::uint32_t> copies(mesh.triangles.size(), 0);  // per representative face
   for (std::size_t f = 0; f < mesh.triangles.size(); ++f) {
     std::array<std::uint32_t, 3> t = {weld[mesh.triangles[f][0]], weld[mesh.triangles[f][1]],
                                       weld[mesh.triangles[f][2]]};
@@ -35,22 +38,36 @@ UniqueFacesResult unique_faces(const TriangleMesh& mesh) {
     const int orientation = r[1] < r[2] ? 1 : -1;
     std::sort(t.begin(), t.end());
     keys.push_back({t, static_cast<std::uint32_t>(f), orientation});
+    const std::uint64_t hash = (std::uint64_t{t[0]} << 32 | t[1]) ^ IndexHashTable::mix(t[2]);
+    const std::uint32_t first = table.find_or_insert(hash, std::uint32_t(keys.size() - 1), [&](std::uint32_t k) {
+      const std::array<std::uint32_t, 3>& o = keys[k].sorted;  // not operator== (a memcmp call)
+      return o[0] == t[0] && o[1] == t[1] && o[2] == t[2];
+    });
+    ++copies[keys[first].face];
   }
-  tbb::parallel_sort(keys.begin(), keys.end(), [](const Key& a, const Key& b) {
-    return a.sorted != b.sorted ? a.sorted < b.sorted : a.face < b.face;
+  // Sets met once keep their face; every face of a repeated set goes through the sort.
+  std::vector<std::uint32_t> kept;
+  kept.reserve(keys.size());
+  std::vector<Key> repeated;
+  for (const Key& k : keys) {
+    if (copies[k.face] == 1)
+      kept.push_back(k.face);
+    else  // a representative with copies, or a copy (0: counted on its representative)
+      repeated.push_back(k);
+  }
+  std::sort(repeated.begin(), repeated.end(), [](const Key& x, const Key& y) {
+    return x.sorted != y.sorted ? x.sorted < y.sorted : x.face < y.face;
   });
   // Copies of a face: their orientations add up. Opposite copies cancel (a double-sided sheet
   // encloses nothing), so a group keeps one copy of the net orientation, or none when it is 0.
-  std::vector<std::uint32_t> kept;
-  kept.reserve(keys.size());
-  for (std::size_t k = 0; k < keys.size();) {
+  for (std::size_t k = 0; k < repeated.size();) {
     std::size_t end = k;
     int net = 0;
-    while (end < keys.size() && keys[end].sorted == keys[k].sorted) net += keys[end++].orientation;
+    while (end < repeated.size() && repeated[end].sorted == repeated[k].sorted) net += repeated[end++].orientation;
     std::size_t keep = end;
     for (std::size_t j = k; j < end && net != 0; ++j)
-      if (keys[j].orientation == (net > 0 ? 1 : -1)) { keep = j; break; }
-    if (keep != end) kept.push_back(keys[keep].face);
+      if (repeated[j].orientation == (net > 0 ? 1 : -1)) { keep = j; break; }
+    if (keep != end) kept.push_back(repeated[keep].face);
     result.duplicates_removed += (end - k) - (keep != end ? 1 : 0);
     k = end;
   }

@@ -8,7 +8,9 @@
 // (a double-sided sheet encloses nothing). Winding numbers of a soup count every copy of a face,
 // so a duplicated face would otherwise change inside/outside near it; distances do not
 // depend on this (the closest point transform uses the mesh as given).
-// Cost: O(V log V + F log F). Threading: TBB sorts; the result is the same for any thread count. Errors: none beyond bad_alloc.
+// Cost: O(V + F) expected (hash tables of positions and of vertex sets; only faces met more
+//   than once are sorted). Threading: none. Errors: Error{LimitExceeded} for 2^32 - 1 or more
+//   vertices (weld_exact), else none beyond bad_alloc.
 #pragma once
 
 #include "io/triangle_mesh.hpp"

@@ -1,0 +1,52 @@
+// IndexHashTable: open addressing over 32-bit ids whose keys live elsewhere (positions,
+// vertex triples): the caller hashes a key and says whether a stored id holds it. Linear
+// probing in a power-of-two table at most half full; no deletion. Used to group equal keys in
+// one pass where a sort would cost O(n log n) (weld_exact, unique_faces).
+//
+// find_or_insert(hash, id, equal): the stored id whose key equal(stored) says is the same, or
+//   `id`, stored now, when there is none (so inserting in increasing id order maps every key to
+//   its lowest id). Cost: O(1) expected. Threading: none (one table per caller).
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+namespace levelset {
+
+class IndexHashTable {
+ public:
+  explicit IndexHashTable(std::size_t capacity) {
+    std::size_t size = 16;
+    while (size < 2 * capacity) size *= 2;
+    slots_.assign(size, kEmpty);
+    mask_ = size - 1;
+  }
+
+  template <typename Equal>
+  std::uint32_t find_or_insert(std::uint64_t hash, std::uint32_t id, Equal&& equal) {
+    for (std::size_t s = mix(hash) & mask_;; s = (s + 1) & mask_) {
+      const std::uint32_t stored = slots_[s];
+      if (stored == kEmpty) {
+        slots_[s] = id;
+        return id;
+      }
+      if (equal(stored)) return stored;
+    }
+  }
+
+  // A 64-bit finaliser (the murmur3 one): keys that differ in few bits land far apart.
+  static std::uint64_t mix(std::uint64_t h) {
+    h ^= h >> 33;
+    h *= 0xff51afd7ed558ccdull;
+    h ^= h >> 33;
+    h *= 0xc4ceb9fe1a85ec53ull;
+    return h ^ (h >> 33);
+  }
+
+ private:
+  static constexpr std::uint32_t kEmpty = 0xffffffffu;
+  std::vector<std::uint32_t> slots_;
+  std::size_t mask_ = 0;
+};
+
+}  // namespace levelset
