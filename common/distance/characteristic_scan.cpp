@@ -7,9 +7,9 @@
 #include <limits>
 
 #include <tbb/parallel_for.h>
-#include <tbb/parallel_sort.h>
 
 #include "distance/brick_set.hpp"
+#include "distance/edge_uses.hpp"
 #include "distance/open_edges.hpp"
 #include "geometry/point_triangle.hpp"
 
@@ -32,20 +32,7 @@ Adjacency build_adjacency(const TriangleMesh& mesh) {
   Adjacency adj;
   adj.welded = weld_exact(mesh.vertices);
   const std::size_t nt = mesh.triangles.size(), nv = mesh.vertices.size();
-  struct EdgeUse {
-    std::uint32_t lo, hi, tri, k;
-  };
-  std::vector<EdgeUse> uses(3 * nt);
-  for (std::size_t t = 0; t < nt; ++t)
-    for (std::uint32_t k = 0; k < 3; ++k) {
-      const std::uint32_t a = adj.welded[mesh.triangles[t][k]], b = adj.welded[mesh.triangles[t][(k + 1) % 3]];
-      uses[3 * t + k] = {std::min(a, b), std::max(a, b), std::uint32_t(t), k};
-    }
-  tbb::parallel_sort(uses.begin(), uses.end(), [](const EdgeUse& x, const EdgeUse& y) {
-    if (x.lo != y.lo) return x.lo < y.lo;
-    if (x.hi != y.hi) return x.hi < y.hi;
-    return x.tri < y.tri || (x.tri == y.tri && x.k < y.k);
-  });
+  const std::vector<EdgeUse> uses = sorted_edge_uses(mesh, adj.welded);
   adj.across.assign(3 * nt, kNoTriangle);
   adj.first_triangle.assign(nv, kNoTriangle);
   // Distinct edges (first use of each run); the rings in CSR form, each vertex's neighbours in
@@ -54,10 +41,10 @@ Adjacency build_adjacency(const TriangleMesh& mesh) {
   adj.ring_offsets.assign(nv + 1, 0);
   for (std::size_t i = 0; i < uses.size();) {
     std::size_t j = i;
-    while (j < uses.size() && uses[j].lo == uses[i].lo && uses[j].hi == uses[i].hi) ++j;
+    while (j < uses.size() && uses[j].same_edge(uses[i])) ++j;
     if (j - i == 2 && uses[i].lo != uses[i].hi) {
-      adj.across[3 * uses[i].tri + uses[i].k] = uses[i + 1].tri;
-      adj.across[3 * uses[i + 1].tri + uses[i + 1].k] = uses[i].tri;
+      adj.across[3 * uses[i].face + uses[i].slot] = uses[i + 1].face;
+      adj.across[3 * uses[i + 1].face + uses[i + 1].slot] = uses[i].face;
     }
     if (uses[i].lo != uses[i].hi && (j - i) % 2 == 1) ++adj.odd_edges;
     if (uses[i].lo != uses[i].hi) {

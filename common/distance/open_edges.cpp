@@ -3,10 +3,9 @@
 #include <cstring>
 #include <numeric>
 
-#include <tbb/parallel_sort.h>
-
 #include "core/error.hpp"
 #include "core/index_hash_table.hpp"
+#include "distance/edge_uses.hpp"
 
 namespace levelset {
 
@@ -41,31 +40,13 @@ std::vector<std::uint32_t> weld_exact(std::span<const Vec3d> positions) {
 std::vector<std::array<std::uint32_t, 2>> open_edges(const TriangleMesh& mesh,
                                                      std::span<const std::uint32_t> welded,
                                                      const std::vector<bool>& counts) {
-  struct Use {
-    std::uint64_t key;
-    int direction;
-    bool operator<(const Use& o) const {
-      return key != o.key ? key < o.key : direction < o.direction;
-    }
-  };
-  std::vector<Use> uses;
-  uses.reserve(3 * mesh.triangles.size());
-  for (std::size_t t = 0; t < mesh.triangles.size(); ++t) {
-    if (!counts[t]) continue;
-    const auto& f = mesh.triangles[t];
-    for (int k = 0; k < 3; ++k) {
-      const std::uint64_t a = welded[f[k]], b = welded[f[(k + 1) % 3]];
-      if (a == b) continue;
-      uses.push_back({a < b ? (a << 32) | b : (b << 32) | a, a < b ? 1 : -1});
-    }
-  }
-  tbb::parallel_sort(uses.begin(), uses.end());
+  const std::vector<EdgeUse> uses = sorted_edge_uses(mesh, welded, counts);
   std::vector<std::array<std::uint32_t, 2>> open;
   for (std::size_t i = 0; i < uses.size();) {
     int net = 0;
     std::size_t j = i;
-    for (; j < uses.size() && uses[j].key == uses[i].key; ++j) net += uses[j].direction;
-    if (net != 0) open.push_back({std::uint32_t(uses[i].key >> 32), std::uint32_t(uses[i].key)});
+    for (; j < uses.size() && uses[j].same_edge(uses[i]); ++j) net += uses[j].forward ? 1 : -1;
+    if (net != 0 && uses[i].lo != uses[i].hi) open.push_back({uses[i].lo, uses[i].hi});
     i = j;
   }
   return open;

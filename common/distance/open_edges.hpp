@@ -15,7 +15,7 @@
 //   holes and open borders, edges of inconsistent or non-orientable regions, unmatched
 //   non-manifold fins. Away from them the winding number jumps by exact integers across the
 //   surface and is constant elsewhere; near them it also varies continuously.
-//   Cost: O(F log F) (one parallel sort of 3F records). Threading: TBB, deterministic.
+//   Cost: O(F + V) (sorted_edge_uses, edge_uses.hpp). Threading: none.
 //   Errors: none (indices must be valid).
 #pragma once
 

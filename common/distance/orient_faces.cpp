@@ -10,23 +10,12 @@
 #include "core/error.hpp"
 #include "core/huge_pages.hpp"
 #include "io/validate_mesh.hpp"
+#include "distance/edge_uses.hpp"
 #include "distance/open_edges.hpp"
 
 namespace levelset {
 
 namespace {
-
-struct EdgeUse {
-  std::uint64_t key;  // (min vertex << 32) | max vertex
-  std::uint32_t face;
-  std::uint8_t slot;  // edge k of the face: (f[k], f[k+1])
-  bool forward;       // f[k] < f[k+1]
-  bool operator<(const EdgeUse& o) const {
-    if (key != o.key) return key < o.key;
-    if (face != o.face) return face < o.face;
-    return slot < o.slot;
-  }
-};
 
 struct Link {
   std::uint32_t face;
@@ -58,46 +47,15 @@ OrientResult orient_faces(TriangleMesh input, const OrientOptions& options) {
     id = weld_exact(mesh.vertices);
   }
 
-  // Edge uses of non-degenerate faces, grouped by undirected edge: in (key, face, slot) order,
-  // by a counting sort on the lower vertex (uses are made in face and slot order, so each
-  // vertex's bucket is already in that order) and an insertion sort on the higher one within
-  // each bucket (a vertex's edges: a handful; a fan's apex is sorted).
-  std::vector<bool> is_degenerate(nf);
-  std::vector<std::uint32_t> bucket(id.size() + 1, 0);
+  // Edge uses of non-degenerate faces, grouped by undirected edge.
+  std::vector<bool> counted(nf);
   for (std::size_t t = 0; t < nf; ++t) {
     const auto& f = mesh.triangles[t];
-    is_degenerate[t] =
-        degenerate(mesh, f) || id[f[0]] == id[f[1]] || id[f[1]] == id[f[2]] || id[f[2]] == id[f[0]];
-    if (is_degenerate[t]) {
-      ++result.degenerate_faces;
-      continue;
-    }
-    for (int k = 0; k < 3; ++k) ++bucket[std::min(id[f[k]], id[f[(k + 1) % 3]]) + 1];
+    counted[t] =
+        !(degenerate(mesh, f) || id[f[0]] == id[f[1]] || id[f[1]] == id[f[2]] || id[f[2]] == id[f[0]]);
+    result.degenerate_faces += !counted[t];
   }
-  for (std::size_t v = 0; v + 1 < bucket.size(); ++v) bucket[v + 1] += bucket[v];
-  std::vector<EdgeUse> uses;
-  resize_with_huge_pages(uses, bucket.back());
-  {
-    std::vector<std::uint32_t> fill(bucket.begin(), bucket.end() - 1);
-    for (std::size_t t = 0; t < nf; ++t) {
-      if (is_degenerate[t]) continue;
-      const auto& f = mesh.triangles[t];
-      for (int k = 0; k < 3; ++k) {
-        const std::uint32_t a = id[f[k]], b = id[f[(k + 1) % 3]];
-        const std::uint64_t lo = a < b ? a : b, hi = a < b ? b : a;
-        uses[fill[lo]++] = {(lo << 32) | hi, std::uint32_t(t), std::uint8_t(k), a < b};
-      }
-    }
-  }
-  for (std::size_t v = 0; v + 1 < bucket.size(); ++v) {
-    const std::uint32_t begin = bucket[v], end = bucket[v + 1];
-    if (end - begin > 32) {  // a fan's apex: its uses sorted like any (the order is total)
-      std::sort(uses.begin() + begin, uses.begin() + end);
-      continue;
-    }
-    for (std::uint32_t i = begin + 1; i < end; ++i)
-      for (std::uint32_t j = i; j > begin && uses[j] < uses[j - 1]; --j) std::swap(uses[j], uses[j - 1]);
-  }
+  std::vector<EdgeUse> uses = sorted_edge_uses(mesh, id, counted);
   options.progress.step(0.4, "orient");
 
   // Manifold edges become links between their two faces (CSR, neighbours sorted by index).
@@ -105,7 +63,7 @@ OrientResult orient_faces(TriangleMesh input, const OrientOptions& options) {
   std::vector<std::pair<std::uint32_t, std::uint32_t>> pairs;  // index into uses of each pair
   for (std::size_t i = 0; i < uses.size();) {
     std::size_t j = i + 1;
-    while (j < uses.size() && uses[j].key == uses[i].key) ++j;
+    while (j < uses.size() && uses[j].same_edge(uses[i])) ++j;
     if (j - i == 2) {
       pairs.push_back({std::uint32_t(i), std::uint32_t(i + 1)});
       ++offsets[uses[i].face + 1];
@@ -140,7 +98,7 @@ OrientResult orient_faces(TriangleMesh input, const OrientOptions& options) {
   std::vector<std::uint32_t> queue;
   queue.reserve(nf);
   for (std::size_t seed = 0; seed < nf; ++seed) {
-    if (is_degenerate[seed] || reached[seed]) continue;
+    if (!counted[seed] || reached[seed]) continue;
     ++result.components;
     const std::size_t begin = queue.size();
     queue.push_back(std::uint32_t(seed));
