@@ -14,6 +14,7 @@
 #include <utility>
 
 #include "core/error.hpp"
+#include "core/huge_pages.hpp"
 
 namespace levelset {
 
@@ -165,7 +166,10 @@ std::string read_file_bytes(const fs::path& path, std::uint64_t max_bytes) {
       seen().read.insert(id);
     }
   }
-  std::string bytes(size, '\0');
+  std::string bytes;
+  bytes.reserve(size);
+  prefault_for_write(bytes.data(), size);  // one call, not a trap per page of a large file
+  bytes.resize(size);
   in.read(bytes.data(), static_cast<std::streamsize>(size));
   if (static_cast<std::uint64_t>(in.gcount()) != size)
     throw Error(ErrorCode::IoError, path.string(), "short read");

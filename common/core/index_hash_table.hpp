@@ -11,6 +11,8 @@
 #include <cstdint>
 #include <vector>
 
+#include "core/huge_pages.hpp"
+
 namespace levelset {
 
 class IndexHashTable {
@@ -18,6 +20,8 @@ class IndexHashTable {
   explicit IndexHashTable(std::size_t capacity) {
     std::size_t size = 16;
     while (size < 2 * capacity) size *= 2;
+    slots_.reserve(size);
+    prefault_for_write(slots_.data(), size * sizeof(std::uint32_t));
     slots_.assign(size, kEmpty);
     mask_ = size - 1;
   }

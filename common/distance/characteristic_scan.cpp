@@ -8,6 +8,8 @@
 
 #include <tbb/parallel_for.h>
 
+#include "core/huge_pages.hpp"
+#include "core/uninitialized_vector.hpp"
 #include "distance/brick_set.hpp"
 #include "distance/edge_uses.hpp"
 #include "distance/open_edges.hpp"
@@ -103,33 +105,41 @@ Vec3d unit(const Vec3d& v) {
 // floats order like their bits, so the minimum is the nearest triangle, ties to the lowest.
 class MinField {
  public:
-  // Cells set to empty in parallel (first touch of the pages spread over the threads).
-  explicit MinField(const BrickSet& set) : set_(set), cells_(set.bricks.size() * std::size_t(kBrickVoxels)) {
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, cells_.size(), 1 << 14), [&](const auto& r) {
-      for (std::size_t i = r.begin(); i != r.end(); ++i) cells_[i].store(kEmpty, std::memory_order_relaxed);
+  // Cells allocated uninitialised, their pages faulted in by one call (prefault_for_write: a
+  // std::vector of atomics zeroed them on one thread first, a trap per 4 KiB page of ~100 MB
+  // for a dense mesh), then set to empty in parallel.
+  explicit MinField(const BrickSet& set) : set_(set) {
+    const std::size_t n = set.bricks.size() * std::size_t(kBrickVoxels);
+    cells_.reserve(n);
+    prefault_for_write(cells_.data(), n * sizeof(std::uint64_t));
+    cells_.resize(n);
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 1 << 14), [&](const auto& r) {
+      for (std::size_t i = r.begin(); i != r.end(); ++i) cells_[i] = kEmpty;
     });
   }
   static constexpr std::uint64_t kEmpty = ~std::uint64_t{0};
 
   const BrickSet& set() const { return set_; }
   std::size_t size() const { return cells_.size(); }
-  std::uint64_t load(std::size_t i) const { return cells_[i].load(std::memory_order_relaxed); }
+  std::uint64_t load(std::size_t i) const { return cell(i).load(std::memory_order_relaxed); }
   // The best distance offered so far (+inf: none). Another thread may lower it at any time;
   // a value above it can never win, so callers may skip computing such values.
   float best(std::size_t cell) const {
-    const std::uint64_t v = cells_[cell].load(std::memory_order_relaxed);
+    const std::uint64_t v = this->cell(cell).load(std::memory_order_relaxed);
     return v == kEmpty ? std::numeric_limits<float>::infinity() : std::bit_cast<float>(std::uint32_t(v >> 32));
   }
   void offer(std::size_t cell, float distance, std::uint32_t tri) {
     const std::uint64_t value = (std::uint64_t(std::bit_cast<std::uint32_t>(distance)) << 32) | tri;
-    std::uint64_t old = cells_[cell].load(std::memory_order_relaxed);
-    while (value < old && !cells_[cell].compare_exchange_weak(old, value, std::memory_order_relaxed)) {
+    std::atomic_ref<std::uint64_t> c = this->cell(cell);
+    std::uint64_t old = c.load(std::memory_order_relaxed);
+    while (value < old && !c.compare_exchange_weak(old, value, std::memory_order_relaxed)) {
     }
   }
 
  private:
+  std::atomic_ref<std::uint64_t> cell(std::size_t i) const { return std::atomic_ref<std::uint64_t>(cells_[i]); }
   const BrickSet& set_;
-  std::vector<std::atomic<std::uint64_t>> cells_;
+  mutable UninitializedVector<std::uint64_t> cells_;  // accessed through atomic_ref once filled
 };
 
 class Scanner {
@@ -579,7 +589,11 @@ CharacteristicScanResult characteristic_scan(const TriangleMesh& mesh, const std
   result.odd_edges = adj.odd_edges;
   ClosestTriangleField& out = result.field;
   out.bricks = set.bricks;
-  out.distance.resize(field.size());  // every cell written below
+  out.distance.reserve(field.size());  // every cell written below, its pages faulted in first
+  prefault_for_write(out.distance.data(), field.size() * sizeof(float));
+  out.distance.resize(field.size());
+  out.owner.reserve(field.size());
+  prefault_for_write(out.owner.data(), field.size() * sizeof(std::uint32_t));
   out.owner.resize(field.size());
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, field.size(), 1 << 14), [&](const auto& r) {
     for (std::size_t i = r.begin(); i != r.end(); ++i) {

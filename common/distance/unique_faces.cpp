@@ -2,6 +2,7 @@
 
 #include <algorithm>
 
+#include "core/huge_pages.hpp"
 #include "core/index_hash_table.hpp"
 #include "distance/open_edges.hpp"
 
@@ -12,7 +13,9 @@ UniqueFacesResult unique_faces(const TriangleMesh& mesh) {
   const std::vector<std::uint32_t> weld = weld_exact(mesh.vertices);
 
   UniqueFacesResult result;
-  result.mesh.vertices = mesh.vertices;
+  result.mesh.vertices.reserve(mesh.vertices.size());
+  prefault_for_write(result.mesh.vertices.data(), mesh.vertices.size() * sizeof(Vec3d));
+  result.mesh.vertices.assign(mesh.vertices.begin(), mesh.vertices.end());
   struct Key {
     std::array<std::uint32_t, 3> sorted;
     std::uint32_t face;
@@ -22,8 +25,10 @@ UniqueFacesResult unique_faces(const TriangleMesh& mesh) {
   // representative); only the sets met more than once are sorted below.
   std::vector<Key> keys;
   keys.reserve(mesh.triangles.size());
+  prefault_for_write(keys.data(), mesh.triangles.size() * sizeof(Key));
   IndexHashTable table(mesh.triangles.size());
-  std::vector<std::uint32_t> copies(mesh.triangles.size(), 0);  // per representative face
+  std::vector<std::uint32_t> copies;  // per representative face
+  resize_with_huge_pages(copies, mesh.triangles.size());
   for (std::size_t f = 0; f < mesh.triangles.size(); ++f) {
     std::array<std::uint32_t, 3> t = {weld[mesh.triangles[f][0]], weld[mesh.triangles[f][1]],
                                       weld[mesh.triangles[f][2]]};
@@ -73,7 +78,7 @@ UniqueFacesResult unique_faces(const TriangleMesh& mesh) {
   }
   // Same face count and order as the input (face indices stay valid); a dropped face becomes
   // the point triangle (a, a, a), which has no area, no solid angle and no crossings.
-  result.mesh.triangles.resize(mesh.triangles.size());
+  resize_with_huge_pages(result.mesh.triangles, mesh.triangles.size());
   for (std::size_t f = 0; f < mesh.triangles.size(); ++f) {
     const std::uint32_t a = weld[mesh.triangles[f][0]];
     result.mesh.triangles[f] = {a, a, a};
