@@ -5,7 +5,9 @@
 //
 // find_or_insert(hash, id, equal): the stored id whose key equal(stored) says is the same, or
 //   `id`, stored now, when there is none (so inserting in increasing id order maps every key to
-//   its lowest id). Cost: O(1) expected. Threading: none (one table per caller).
+//   its lowest id). Cost: O(1) expected. The table holds at most `capacity` ids (the
+//   constructor's); with an unknown count, grow(hash_of) doubles it whenever full() says so.
+// Threading: none (one table per caller).
 #pragma once
 
 #include <cstdint>
@@ -32,9 +34,26 @@ class IndexHashTable {
       const std::uint32_t stored = slots_[s];
       if (stored == kEmpty) {
         slots_[s] = id;
+        ++stored_;
         return id;
       }
       if (equal(stored)) return stored;
+    }
+  }
+
+  // Whether `capacity` ids are stored: grow before the next insertion.
+  bool full() const { return stored_ * 2 >= slots_.size(); }
+  // Twice the capacity; every stored id is placed again by hash_of(id), its key's hash.
+  template <typename HashOf>
+  void grow(HashOf&& hash_of) {
+    std::vector<std::uint32_t> old(2 * slots_.size(), kEmpty);
+    old.swap(slots_);
+    mask_ = slots_.size() - 1;
+    for (const std::uint32_t id : old) {
+      if (id == kEmpty) continue;
+      std::size_t s = mix(hash_of(id)) & mask_;
+      while (slots_[s] != kEmpty) s = (s + 1) & mask_;
+      slots_[s] = id;
     }
   }
 
@@ -50,7 +69,7 @@ class IndexHashTable {
  private:
   static constexpr std::uint32_t kEmpty = 0xffffffffu;
   std::vector<std::uint32_t> slots_;
-  std::size_t mask_ = 0;
+  std::size_t mask_ = 0, stored_ = 0;
 };
 
 }  // namespace levelset

@@ -1,13 +1,15 @@
 #include "distance/brick_triangle_lists.hpp"
 
+#include <algorithm>
 #include <atomic>
 #include <cmath>
 #include <string>
 
 #include <tbb/parallel_for.h>
-#include <tbb/parallel_sort.h>
 
 #include "core/error.hpp"
+#include "core/huge_pages.hpp"
+#include "core/index_hash_table.hpp"
 #include "io/validate_mesh.hpp"
 
 namespace levelset {
@@ -60,6 +62,51 @@ void for_each_brick_near(const Vec3d& a, const Vec3d& b, const Vec3d& c, const G
       }
 }
 
+// The lists from pairs in triangle order, without sorting the pairs: distinct bricks in
+// first-seen order (a hash table), sorted by key (a few thousand where the pairs are millions),
+// then each pair's triangle at its brick's next slot, so each list is in triangle order.
+BrickTriangleLists group_by_brick(const std::vector<Pair>& pairs, double margin) {
+  BrickTriangleLists lists;
+  lists.margin = margin;
+  std::vector<std::uint64_t> keys;  // distinct, first-seen order
+  std::vector<std::uint64_t> count;
+  std::vector<std::uint32_t> brick_of;
+  resize_with_huge_pages(brick_of, pairs.size());
+  IndexHashTable table(std::min<std::size_t>(pairs.size(), 4096));
+  for (std::size_t i = 0; i < pairs.size(); ++i) {
+    const std::uint64_t key = pairs[i].key;
+    // Consecutive pairs mostly share a brick (a triangle's bricks, then its neighbour's).
+    std::uint32_t id;
+    if (i > 0 && pairs[i - 1].key == key) {
+      id = brick_of[i - 1];
+    } else {
+      if (table.full()) table.grow([&](std::uint32_t k) { return keys[k]; });
+      id = table.find_or_insert(key, std::uint32_t(keys.size()), [&](std::uint32_t k) { return keys[k] == key; });
+      if (id == keys.size()) {
+        keys.push_back(key);
+        count.push_back(0);
+      }
+    }
+    ++count[id];
+    brick_of[i] = id;
+  }
+  std::vector<std::uint32_t> order(keys.size());
+  for (std::uint32_t k = 0; k < order.size(); ++k) order[k] = k;
+  std::sort(order.begin(), order.end(), [&](std::uint32_t a, std::uint32_t b) { return keys[a] < keys[b]; });
+  std::vector<std::uint64_t> next(keys.size());  // per brick id: its next slot
+  lists.bricks.reserve(keys.size());
+  lists.offsets.reserve(keys.size() + 1);
+  lists.offsets.push_back(0);
+  for (std::uint32_t id : order) {
+    next[id] = lists.offsets.back();
+    lists.bricks.push_back(brick_from_key(keys[id]));
+    lists.offsets.push_back(lists.offsets.back() + count[id]);
+  }
+  resize_with_huge_pages(lists.triangles, pairs.size());
+  for (std::size_t i = 0; i < pairs.size(); ++i) lists.triangles[next[brick_of[i]]++] = pairs[i].triangle;
+  return lists;
+}
+
 }  // namespace
 
 BrickTriangleLists bin_triangles_to_bricks(const TriangleMesh& mesh, const BinTrianglesOptions& options) {
@@ -95,8 +142,9 @@ BrickTriangleLists bin_triangles_to_bricks(const TriangleMesh& mesh, const BinTr
   for (std::size_t t = 0; t < nt; ++t) counts[t + 1] += counts[t];
   options.progress.step(0.3, "bin");
 
-  // Pass 2: fill, then sort by (brick key, triangle).
-  std::vector<Pair> pairs(counts[nt]);
+  // Pass 2: fill (in triangle order: each triangle's pairs at its offset).
+  std::vector<Pair> pairs;
+  resize_with_huge_pages(pairs, counts[nt]);
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, nt, 256), [&](const tbb::blocked_range<std::size_t>& r) {
     for (std::size_t t = r.begin(); t != r.end(); ++t) {
       const auto& tri = mesh.triangles[t];
@@ -107,22 +155,9 @@ BrickTriangleLists bin_triangles_to_bricks(const TriangleMesh& mesh, const BinTr
                           });
     }
   });
-  tbb::parallel_sort(pairs.begin(), pairs.end());
-  options.progress.step(0.7, "bin");
-
-  BrickTriangleLists lists;
-  lists.margin = options.margin;
-  lists.triangles.resize(pairs.size());
-  lists.offsets.push_back(0);
-  for (std::size_t i = 0; i < pairs.size(); ++i) {
-    if (i == 0 || pairs[i].key != pairs[i - 1].key) {
-      if (i > 0) lists.offsets.push_back(i);
-      lists.bricks.push_back(brick_from_key(pairs[i].key));
-    }
-    lists.triangles[i] = pairs[i].triangle;
-  }
-  if (!pairs.empty()) lists.offsets.push_back(pairs.size());
-  return lists;
+  options.progress.step(0.6, "bin");
+  return group_by_brick(pairs, options.margin);
 }
+
 
 }  // namespace levelset

@@ -8,7 +8,9 @@
 //   column by column at brick resolution, then culled by the exact box-triangle distance bound;
 //   the lists are a superset of the triangles truly within the margin only where the exact
 //   test is conservative (it never misses one).
-// Cost: O(triangles * bricks touched per triangle) plus a parallel sort of the pairs.
+// Cost: O(triangles * bricks touched per triangle) to make the pairs, O(pairs) expected to
+//   group them by brick (a hash table of the distinct bricks) and O(B log B) to order the B
+//   distinct bricks.
 // Threading: TBB; the result is identical for any thread count.
 // Errors: Error{LimitExceeded} when a triangle would touch more than options.max_pairs
 //   brick-triangle pairs in total (a mesh far larger than the grid allows) or indices leave the
