@@ -10,6 +10,7 @@
 #include <random>
 #include <tuple>
 
+#include "core/index_hash_table.hpp"
 #include "distance/open_edges.hpp"
 #include "distance/orient_faces.hpp"
 #include "distance/unique_faces.hpp"
@@ -128,6 +129,39 @@ TEST(OrientFaces, ConeWithAHighDegreeApexBecomesConsistentAndOutward) {
                       (a[0] == b[2] && a[1] == b[0] && a[2] == b[1]);
     EXPECT_TRUE(same) << "face " << t;
   }
+}
+
+}  // namespace
+}  // namespace levelset
+
+namespace levelset {
+namespace {
+
+// IndexHashTable grown from 16 slots to hold 50,000 distinct keys among 200,000 lookups:
+// every key maps to the id of its first occurrence, as a std::map says.
+TEST(IndexHashTable, GrowsAndMapsEveryKeyToItsFirstId) {
+  std::mt19937_64 rng(5);
+  std::uniform_int_distribution<std::uint64_t> pick(0, 49999);
+  std::vector<std::uint64_t> keys;  // distinct, by id
+  std::map<std::uint64_t, std::uint32_t> reference;
+  IndexHashTable table(1);
+  int grown = 0;
+  for (int i = 0; i < 200000; ++i) {
+    const std::uint64_t key = pick(rng) * 0x100000001ull;  // keys that differ in high bits too
+    if (table.full()) {
+      table.grow([&](std::uint32_t id) { return keys[id]; });
+      ++grown;
+    }
+    const std::uint32_t id =
+        table.find_or_insert(key, std::uint32_t(keys.size()), [&](std::uint32_t k) { return keys[k] == key; });
+    const bool fresh = id == keys.size();
+    if (fresh) keys.push_back(key);
+    const auto [it, inserted] = reference.try_emplace(key, id);
+    ASSERT_EQ(it->second, id) << "lookup " << i;
+    ASSERT_EQ(inserted, fresh) << "lookup " << i;
+  }
+  EXPECT_EQ(keys.size(), reference.size());
+  EXPECT_GT(grown, 10);
 }
 
 }  // namespace
