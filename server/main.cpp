@@ -24,7 +24,7 @@ using levelset::cli::add_common_options;
 
 int main(int argc, char** argv) {
   levelset::keep_freed_memory();  // steps and requests reuse freed buffers (malloc_policy.hpp)
-  CLI::App app{"levelsetd: narrow-band level-set computation (batch subcommands; daemon to come)"};
+  CLI::App app{"levelsetd: narrow-band level-set computation (batch subcommands and the serve daemon)"};
   app.set_version_flag("--version", std::string("levelsetd ") + LEVELSET_VERSION);
   app.require_subcommand(1);
   bool allow_special = false;
