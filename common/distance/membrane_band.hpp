@@ -41,7 +41,8 @@
 // Cost: nothing beyond one pass over the bricks without membrane voxels; otherwise
 //   O(membrane voxels) direct queries plus ~9-80 per added brick, and the march over the bricks
 //   within W of the membrane (4 bytes per voxel of those bricks).
-// Threading: TBB per brick (evaluation, membrane voxels, merge); the march is serial. Results
+// Threading: TBB per brick (evaluation, membrane voxels, merge, and the march: eikonal_march
+//   runs bricks of a checkerboard colour in parallel). Results
 //   do not depend on the thread count.
 // Limits: bricks are only added within the searched box grown by W + 1 voxels; a membrane
 //   reaching past it (w > 1/2 far from the mesh, only for meshes wound several times around
