@@ -17,9 +17,8 @@ namespace levelset {
 namespace {
 
 struct Pair {
-  std::uint64_t key;
+  std::uint64_t key;  // brick_key
   std::uint32_t triangle;
-  bool operator<(const Pair& o) const { return key != o.key ? key < o.key : triangle < o.triangle; }
 };
 
 // Visits the bricks near one triangle: those whose voxel-centre box meets the triangle's
@@ -158,6 +157,5 @@ BrickTriangleLists bin_triangles_to_bricks(const TriangleMesh& mesh, const BinTr
   options.progress.step(0.6, "bin");
   return group_by_brick(pairs, options.margin);
 }
-
 
 }  // namespace levelset
