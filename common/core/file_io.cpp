@@ -167,9 +167,7 @@ std::string read_file_bytes(const fs::path& path, std::uint64_t max_bytes) {
     }
   }
   std::string bytes;
-  bytes.reserve(size);
-  prefault_for_write(bytes.data(), size);  // one call, not a trap per page of a large file
-  bytes.resize(size);
+  resize_with_huge_pages(bytes, size);  // faulted in by one call, not a trap per page
   in.read(bytes.data(), static_cast<std::streamsize>(size));
   if (static_cast<std::uint64_t>(in.gcount()) != size)
     throw Error(ErrorCode::IoError, path.string(), "short read");

@@ -49,12 +49,19 @@ inline void prefault_for_write(const void* data, std::size_t bytes) {
 #endif
 }
 
-// v.resize(n) for an empty vector about to be filled, its pages faulted in first
-// (prefault_for_write): the resize's zero-fill then runs without page faults.
-template <typename T>
-void resize_with_huge_pages(std::vector<T>& v, std::size_t n) {
+// v.reserve(n) for an empty vector (or string) about to be filled, its pages faulted in
+// first (prefault_for_write): the fill then runs without page faults.
+template <typename Vector>
+void reserve_with_huge_pages(Vector& v, std::size_t n) {
   v.reserve(n);
-  prefault_for_write(v.data(), n * sizeof(T));
+  prefault_for_write(v.data(), n * sizeof(typename Vector::value_type));
+}
+
+// v.resize(n) the same way: the resize's zero-fill (none for an UninitializedVector) runs
+// without page faults.
+template <typename Vector>
+void resize_with_huge_pages(Vector& v, std::size_t n) {
+  reserve_with_huge_pages(v, n);
   v.resize(n);
 }
 

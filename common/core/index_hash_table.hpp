@@ -22,8 +22,7 @@ class IndexHashTable {
   explicit IndexHashTable(std::size_t capacity) {
     std::size_t size = 16;
     while (size < 2 * capacity) size *= 2;
-    slots_.reserve(size);
-    prefault_for_write(slots_.data(), size * sizeof(std::uint32_t));
+    reserve_with_huge_pages(slots_, size);
     slots_.assign(size, kEmpty);
     mask_ = size - 1;
   }

@@ -110,9 +110,7 @@ class MinField {
   // for a dense mesh), then set to empty in parallel.
   explicit MinField(const BrickSet& set) : set_(set) {
     const std::size_t n = set.bricks.size() * std::size_t(kBrickVoxels);
-    cells_.reserve(n);
-    prefault_for_write(cells_.data(), n * sizeof(std::uint64_t));
-    cells_.resize(n);
+    resize_with_huge_pages(cells_, n);
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 1 << 14), [&](const auto& r) {
       for (std::size_t i = r.begin(); i != r.end(); ++i) cells_[i] = kEmpty;
     });
@@ -589,12 +587,8 @@ CharacteristicScanResult characteristic_scan(const TriangleMesh& mesh, const std
   result.odd_edges = adj.odd_edges;
   ClosestTriangleField& out = result.field;
   out.bricks = set.bricks;
-  out.distance.reserve(field.size());  // every cell written below, its pages faulted in first
-  prefault_for_write(out.distance.data(), field.size() * sizeof(float));
-  out.distance.resize(field.size());
-  out.owner.reserve(field.size());
-  prefault_for_write(out.owner.data(), field.size() * sizeof(std::uint32_t));
-  out.owner.resize(field.size());
+  resize_with_huge_pages(out.distance, field.size());  // every cell written below
+  resize_with_huge_pages(out.owner, field.size());
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, field.size(), 1 << 14), [&](const auto& r) {
     for (std::size_t i = r.begin(); i != r.end(); ++i) {
       const std::uint64_t value = field.load(i);

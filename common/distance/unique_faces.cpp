@@ -13,8 +13,7 @@ UniqueFacesResult unique_faces(const TriangleMesh& mesh) {
   const std::vector<std::uint32_t> weld = weld_exact(mesh.vertices);
 
   UniqueFacesResult result;
-  result.mesh.vertices.reserve(mesh.vertices.size());
-  prefault_for_write(result.mesh.vertices.data(), mesh.vertices.size() * sizeof(Vec3d));
+  reserve_with_huge_pages(result.mesh.vertices, mesh.vertices.size());
   result.mesh.vertices.assign(mesh.vertices.begin(), mesh.vertices.end());
   struct Key {
     std::array<std::uint32_t, 3> sorted;
@@ -24,8 +23,7 @@ UniqueFacesResult unique_faces(const TriangleMesh& mesh) {
   // Faces grouped by their welded vertex set in one pass (the first face of each set is its
   // representative); only the sets met more than once are sorted below.
   std::vector<Key> keys;
-  keys.reserve(mesh.triangles.size());
-  prefault_for_write(keys.data(), mesh.triangles.size() * sizeof(Key));
+  reserve_with_huge_pages(keys, mesh.triangles.size());
   IndexHashTable table(mesh.triangles.size());
   std::vector<std::uint32_t> copies;  // per representative face
   resize_with_huge_pages(copies, mesh.triangles.size());
