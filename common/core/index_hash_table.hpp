@@ -1,7 +1,10 @@
 // IndexHashTable: open addressing over 32-bit ids whose keys live elsewhere (positions,
 // vertex triples): the caller hashes a key and says whether a stored id holds it. Linear
 // probing in a power-of-two table at most half full; no deletion. Used to group equal keys in
-// one pass where a sort would cost O(n log n) (weld_exact, unique_faces).
+// one pass where a sort would cost O(n log n) (weld_exact, unique_faces,
+// bin_triangles_to_bricks). Each table salts its hashes with a random seed, so input crafted
+// to collide (files come from the network) cannot force quadratic probing; the ids returned
+// do not depend on the seed (a key maps to the first id inserted for it).
 //
 // find_or_insert(hash, id, equal): the stored id whose key equal(stored) says is the same, or
 //   `id`, stored now, when there is none (so inserting in increasing id order maps every key to
@@ -11,6 +14,7 @@
 #pragma once
 
 #include <cstdint>
+#include <random>
 #include <vector>
 
 #include "core/huge_pages.hpp"
@@ -19,7 +23,7 @@ namespace levelset {
 
 class IndexHashTable {
  public:
-  explicit IndexHashTable(std::size_t capacity) {
+  explicit IndexHashTable(std::size_t capacity) : seed_(random_seed()) {
     std::size_t size = 16;
     while (size < 2 * capacity) size *= 2;
     reserve_with_huge_pages(slots_, size);
@@ -29,7 +33,7 @@ class IndexHashTable {
 
   template <typename Equal>
   std::uint32_t find_or_insert(std::uint64_t hash, std::uint32_t id, Equal&& equal) {
-    for (std::size_t s = mix(hash) & mask_;; s = (s + 1) & mask_) {
+    for (std::size_t s = mix(hash ^ seed_) & mask_;; s = (s + 1) & mask_) {
       const std::uint32_t stored = slots_[s];
       if (stored == kEmpty) {
         slots_[s] = id;
@@ -50,7 +54,7 @@ class IndexHashTable {
     mask_ = slots_.size() - 1;
     for (const std::uint32_t id : old) {
       if (id == kEmpty) continue;
-      std::size_t s = mix(hash_of(id)) & mask_;
+      std::size_t s = mix(hash_of(id) ^ seed_) & mask_;
       while (slots_[s] != kEmpty) s = (s + 1) & mask_;
       slots_[s] = id;
     }
@@ -66,7 +70,12 @@ class IndexHashTable {
   }
 
  private:
+  static std::uint64_t random_seed() {
+    std::random_device device;
+    return (std::uint64_t{device()} << 32) ^ device();
+  }
   static constexpr std::uint32_t kEmpty = 0xffffffffu;
+  std::uint64_t seed_;
   std::vector<std::uint32_t> slots_;
   std::size_t mask_ = 0, stored_ = 0;
 };
