@@ -86,13 +86,13 @@ std::string stage_line(const ReconstructionStage& stage) {
   char line[640];
   std::snprintf(line, sizeof line,
                 "level %d: h %.4g, shell offset %.2f voxel, %s %d, change %.4f voxel, noise %.3f voxel (height fits %.3f), "
-                "%s (%d points), smoothing %d, %llu buried points, %d regions carved (%llu voxels), %llu voxels, "
+                "%s (%d points), smoothing %d, %llu buried points, %d regions carved (%d pierced, %llu voxels), %llu voxels, "
                 "%llu fits (%llu height); start %.3f s, "
                 "fits %.3f s, flow %.3f s, redistance %.3f s, total %.3f s",
                 stage.level, stage.voxel_size, stage.shell_offset, stage.level == 0 ? "flow steps" : "snap passes",
                 stage.steps, stage.last_change, stage.noise, stage.height_noise,
                 stage.second_order ? "second order" : "plane fits", stage.height_neighbors, stage.smoothing,
-                static_cast<unsigned long long>(stage.buried_points), stage.carved_regions,
+                static_cast<unsigned long long>(stage.buried_points), stage.carved_regions, stage.pierced_regions,
                 static_cast<unsigned long long>(stage.carved_voxels),
                 static_cast<unsigned long long>(stage.active_voxels), static_cast<unsigned long long>(stage.fit_voxels),
                 static_cast<unsigned long long>(stage.height_fits), stage.seconds_start, stage.seconds_fit,
@@ -227,7 +227,10 @@ ReconstructionResult reconstruct_surface(const std::vector<Vec3d>& input, const 
     }
     if (level > 0 || levels == 1) {
       // The snap (on a single level: after the flow, with its own curvature).
-      detail::SnapLevel where{level, levels, h_final, {result.sampling.noise, gap}};
+      detail::SnapLevel where{level, levels, h_final, {}};
+      where.carve.noise = result.sampling.noise;
+      where.carve.gap = gap;
+      where.carve.pierce = o.pierce_tunnels;
       detail::SnapOutput snapped = detail::snap_level(std::move(band), *index, o, where, std::move(stage), noise);
       band = std::move(snapped.band);
       stage = std::move(snapped.stage);

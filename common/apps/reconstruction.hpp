@@ -53,7 +53,9 @@
 //   start shell closed are dug out where the points sampling their walls lie buried inside
 //   the front (carve_gaps; reconstruction_parts.hpp carve_buried_gaps: the empty space beside
 //   them, farther than the sampling gap from every point and reaching the outside, turned
-//   outside by simple flips only, so no handle is made; then at least 3 snap passes: homer's
+//   outside by simple flips only, so no handle is made, except a gap lined almost only by
+//   buried points, which reopens whole, tunnels included: pierce_tunnels, CGAL's anchor and
+//   couplingdown; then at least 3 snap passes: homer's
 //   legs at 50k points, bench_reconstruct --sweep); then snap_passes times: every voxel within 1 voxel of the front computes its front offset
 //   e = clamp(s - u, -h, h) from fits of the points near the voxel (the others within 1.5
 //   voxels, which also move, take their neighbours' mean e; the voxels of a column along the
@@ -148,6 +150,7 @@ struct ReconstructionOptions {
   bool guard_snaps = true;      // snaps: the same
   double free_distance = 1.0;   // flow guard: topology may change where the nearest point is farther (coarse voxels)
   bool carve_gaps = true;       // finer levels: reopen gaps the start shell closed over buried points
+  bool pierce_tunnels = true;   // carve_gaps: a gap lined almost only by buried points may reopen as a tunnel
   int max_resolution = 4096;    // cap on the final grid's longest side (voxels)
   ProgressHook progress;
   std::function<void(const std::string&)> log;  // progress lines; empty: none
@@ -171,6 +174,7 @@ struct ReconstructionStage {
   std::uint64_t dropped_components = 0;  // coarsest level: components without data turned to the other sign
   std::uint64_t buried_points = 0;  // finer levels: points buried inside the upsampled front
   int carved_regions = 0;           // finer levels: closed gaps reopened (turned outside)
+  int pierced_regions = 0;          // of them reopened whole, tunnels allowed (pierce_tunnels)
   std::uint64_t carved_voxels = 0;
   std::uint64_t active_voxels = 0;
   std::uint64_t fit_voxels = 0; // local fits computed (cache, or snapped voxels of all passes)

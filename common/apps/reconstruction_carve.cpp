@@ -215,7 +215,11 @@ CarveOutput carve_buried_gaps(NarrowBand band, const PointIndex& index, const Ca
   std::vector<std::uint32_t> size(air.size(), 0);
   std::vector<std::uint32_t> lining(air.size(), 0), lining_buried(air.size(), 0);
   std::vector<std::uint8_t> is_buried(index.size(), 0);
-  for (const std::uint32_t p : buried) is_buried[p] = 1;
+  // The lining counts the points below the front (deeper than max(1.5 h, 2 noise), not the
+  // burial depth): under noise the walls of a closed gap near its mouth lie shallower than
+  // 4 noise, and counting them as front points rejected the gap (CGAL's anchor at 0.5 %).
+  for (const std::uint32_t p : buried_points(band, index, std::max(kCarveDepthVoxels * h, kLiningNoiseDepth * s.noise)))
+    is_buried[p] = 1;
   std::vector<std::uint32_t> seen_by(index.size(), std::uint32_t(-1));
   std::vector<std::pair<std::uint32_t, double>> near;
   BandAccessor acc(band);
@@ -239,7 +243,9 @@ CarveOutput carve_buried_gaps(NarrowBand band, const PointIndex& index, const Ca
       lining_buried[r] += is_buried[p];
     }
   }
-  std::vector<std::uint8_t> carve(air.size(), 0);
+  // 4. Carved regions; those large and lined almost only by buried points may also open
+  // tunnels (a hole through a plate: the air meets the outside at both mouths).
+  std::vector<std::uint8_t> carve(air.size(), 0), pierce(air.size(), 0);
   for (std::size_t i = 0; i < air.size(); ++i) {
     const std::uint32_t r = root[i];
     if (r != i) continue;
@@ -247,19 +253,30 @@ CarveOutput carve_buried_gaps(NarrowBand band, const PointIndex& index, const Ca
         double(lining_buried[r]) >= kMinBuriedLining * double(lining[r])) {
       carve[r] = 1;
       ++out.regions;
+      if (s.pierce && size[r] >= kMinPierceVoxels && double(lining_buried[r]) >= kMinPierceLining * double(lining[r])) {
+        pierce[r] = 1;
+        ++out.pierced_regions;
+      }
     }
   }
-  std::vector<std::uint64_t> carved;
-  for (std::size_t i = 0; i < air.size(); ++i)
+  std::vector<std::uint64_t> carved, pierced;
+  for (std::size_t i = 0; i < air.size(); ++i) {
     if (carve[root[i]]) carved.push_back(air[i]);
+    if (pierce[root[i]]) pierced.push_back(air[i]);
+  }
   if (carved.empty()) return unchanged();
-  // 4. The carved voxels and their inside face neighbours join the band (-h/2 where they were
+  // 5. The carved voxels and their inside face neighbours join the band (-h/2 where they were
   // inactive: every sign change stays between active voxels, the band's invariant); the
   // carved ones turn outside (+h/2) as far as the topology guard lets them: simple flips
   // only, taken again as their neighbours flip, so the region is dug out from the shell
   // inward without making handles. Where only part of a gap could be cleared (a slot
   // narrower than the clearance in places), removing what is left of the shell across it
   // would open tunnels, and opening the rest would leave bridges: both change the genus.
+  // A pierced region turns outside whole (the guard's free voxels): it is empty space
+  // farther than the clearance from every point, so no sampled wall lies across it, and
+  // where it meets the outside at two mouths the tunnel it opens is the data's
+  // (kMinPierceLining: CGAL's anchor and couplingdown at 20k points reopen their holes; a
+  // looser share gave the fist of hand.off tunnels between its fingers).
   // The band is then redistanced out to its half-width (the snaps that follow move the new
   // walls onto the points).
   NarrowBand active = with_active(band, carved);
@@ -277,6 +294,8 @@ CarveOutput carve_buried_gaps(NarrowBand band, const PointIndex& index, const Ca
   TopologyGuardOptions guard;
   guard.eps = 1e-3 * h;
   guard.progress = progress;
+  if (!pierced.empty())
+    guard.free = [&](const Coord& c) { return std::binary_search(pierced.begin(), pierced.end(), key_of(c)); };
   TopologyGuardResult kept = guard_topology(active, active, std::move(proposed), guard);
   out.carved_voxels = carved.size() - std::min<std::uint64_t>(carved.size(), kept.refused_flips);
   active.swap_values(kept.values);

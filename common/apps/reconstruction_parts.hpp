@@ -62,10 +62,13 @@ LevelOutput flow_level(NarrowBand band, const PointIndex& index, const Reconstru
 // inside the front within reach_voxels of a buried point and farther than
 // clearance = max(h, kCarveNoiseDepth noise, gap) from every point form 6-connected regions;
 // a region that meets the outside (the shell spans the gap's mouth) and whose lining (points
-// within clearance + 1.5 h of its boundary) is at least kMinBuriedLining buried is turned
-// outside, by simple flips only (grid/topology_guard.hpp: no handle is made or removed): a
-// part's own interior beside buried points is lined by its surface's points, which lie on
-// the front. Nothing happens with fewer than max(kMinBuried, kMinBuriedShare N) buried
+// within clearance + 1.5 h of its boundary) is at least kMinBuriedLining below the front
+// (deeper than max(kCarveDepthVoxels h, kLiningNoiseDepth noise)) is turned outside, by
+// simple flips only (grid/topology_guard.hpp: no handle is made or removed): a part's own
+// interior beside buried points is lined by its surface's points, which lie on the front.
+// With settings.pierce, a region of at least kMinPierceVoxels whose lining is at least
+// kMinPierceLining below the front turns outside whole, tunnels included (a hole through a
+// plate that the shell spanned: its air meets the outside at both mouths). Nothing happens with fewer than max(kMinBuried, kMinBuriedShare N) buried
 // points, or more than kMaxBuriedShare N (then the front is not near the data at all, and
 // the candidates would be ~reach^3 voxels per point: work and memory stay bounded). The band
 // is rebuilt (the carved voxels and their face neighbours active) and redistanced when a
@@ -79,16 +82,26 @@ inline constexpr double kMinBuriedShare = 5e-4;
 inline constexpr double kMaxBuriedShare = 0.1;
 inline constexpr std::uint32_t kMinCarveVoxels = 8;
 inline constexpr double kMinBuriedLining = 0.5;
+// A point at the front lies within ~noise of it (P(u < -2 noise) ~ 2 %); a closed gap's
+// walls near its mouth lie deeper than that but shallower than the burial depth.
+inline constexpr double kLiningNoiseDepth = 2.0;
+// Pierced regions (tunnels allowed): bench_reconstruct --sweep at 20k points: CGAL's anchor
+// (the ring's hole) and couplingdown (genus 2 -> 6 of 9) reopened at 0.1 % noise; regions
+// of the fist of hand.off lined 50-62 % below the front opened tunnels between its fingers.
+inline constexpr std::uint32_t kMinPierceVoxels = 64;
+inline constexpr double kMinPierceLining = 0.75;
 struct CarveSettings {
   double noise = 0.0;         // the points' noise estimate (world)
   double gap = 0.0;           // the sampling's gap (world): clearance so a region does not leak between samples
   double reach_voxels = 8.0;  // how far from a buried point regions are sought
+  bool pierce = true;         // regions lined almost only by buried points may open tunnels
 };
 struct CarveOutput {
   NarrowBand band;
   std::uint64_t buried = 0;         // points buried before carving
   std::uint64_t carved_voxels = 0;  // turned outside (the topology guard left the others inside)
   int regions = 0;                  // regions carved
+  int pierced_regions = 0;          // of them turned outside whole (tunnels allowed)
   std::vector<std::uint64_t> bricks;  // brick_key of the bricks with carved voxels and their 26 neighbours, sorted
 };
 CarveOutput carve_buried_gaps(NarrowBand band, const PointIndex& index, const CarveSettings& settings,

@@ -472,6 +472,7 @@ SnapOutput snap_level(NarrowBand band, const PointIndex& index, const Reconstruc
     band = std::move(carved.band);
     stage.buried_points = carved.buried;
     stage.carved_regions = carved.regions;
+    stage.pierced_regions = carved.pierced_regions;
     stage.carved_voxels = carved.carved_voxels;
     carved_bricks = std::move(carved.bricks);
   }
