@@ -164,6 +164,19 @@ CgalCase cgal_case(const char* name, std::size_t count = 50000) {
   return c;
 }
 
+// The mean distance from 50k samples of the true surface to `mesh` (large where a gap or hole
+// of the truth is filled).
+double mean_distance_from(const TriangleMesh& truth, const TriangleMesh& mesh) {
+  SurfaceSampleOptions ts;
+  ts.count = 50000;
+  ts.seed = 7;
+  const MeshDistance d(mesh);
+  double sum = 0.0;
+  const std::vector<Vec3d> samples = sample_mesh_surface(truth, ts);
+  for (const Vec3d& p : samples) sum += d.distance(p);
+  return sum / double(samples.size());
+}
+
 TEST(Reconstruction, KeepsTheElephantsThreeHandles) {
   // CGAL's elephant (genus 3: the trunk, and the tusks, meet the body) from 50k points with
   // noise 0.1 % of the diagonal at resolution 256: the coarse level's start shell (offset 2
@@ -203,17 +216,7 @@ TEST(Reconstruction, ReopensTheGapBetweenHomersLegsWithoutNewHandles) {
     EXPECT_EQ(r->measures.genus, 0.0);
   }
   // The true surface's distance to ours (the filled gap is where it was far).
-  SurfaceSampleOptions ts;
-  ts.count = 50000;
-  ts.seed = 7;
-  const std::vector<Vec3d> truth_samples = sample_mesh_surface(truth, ts);
-  auto mean_distance = [&](const TriangleMesh& mesh) {
-    const MeshDistance d(mesh);
-    double sum = 0.0;
-    for (const Vec3d& p : truth_samples) sum += d.distance(p);
-    return sum / double(truth_samples.size());
-  };
-  EXPECT_LT(mean_distance(carved.mesh), 0.9 * mean_distance(closed.mesh));
+  EXPECT_LT(mean_distance_from(truth, carved.mesh), 0.9 * mean_distance_from(truth, closed.mesh));
 }
 
 TEST(Reconstruction, ReopensCouplingdownsHolesAsTunnels) {
@@ -236,17 +239,8 @@ TEST(Reconstruction, ReopensCouplingdownsHolesAsTunnels) {
     EXPECT_LE(r->measures.genus, 9.0);  // never a handle the truth does not have
   }
   EXPECT_GE(pierced.measures.genus, dug.measures.genus + 2.0);
-  SurfaceSampleOptions ts;
-  ts.count = 50000;
-  ts.seed = 7;
-  const std::vector<Vec3d> truth_samples = sample_mesh_surface(coupling.truth, ts);
-  auto mean_distance = [&](const TriangleMesh& mesh) {
-    const MeshDistance d(mesh);
-    double sum = 0.0;
-    for (const Vec3d& p : truth_samples) sum += d.distance(p);
-    return sum / double(truth_samples.size());
-  };
-  EXPECT_LT(mean_distance(pierced.mesh), mean_distance(dug.mesh));  // the holes' walls come back
+  // The holes' walls come back.
+  EXPECT_LT(mean_distance_from(coupling.truth, pierced.mesh), mean_distance_from(coupling.truth, dug.mesh));
 }
 
 }  // namespace
