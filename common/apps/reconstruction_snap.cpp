@@ -92,8 +92,7 @@ constexpr long kMaxSmoothing = 3;
 // worse once the height fits carried the noisy snaps (kHeightGuardNoise): at 0.5 % noise,
 // 20k points, median ratio to Poisson's Chamfer 0.919 -> 0.870 (wins 20 -> 22 of 33), the 0.1 %
 // rows (noise below the reference) unchanged. Before that, sqrt(noise / reference) against
-// none, bench_reconstruct --sweep at
-// 0.5 % noise, 20k points: 15 -> 20 of 33 cases at or below Poisson's Chamfer, median ratio
+// none, bench_reconstruct --sweep at 0.5 % noise, 20k points: 15 -> 20 of 33 cases at or below Poisson's Chamfer, median ratio
 // 1.009 -> 0.977; 50k: 21 cases better, none worse. Below it the count stays (the law's
 // smaller patches: 50k / 0.1 %, 9 cases worse and 3 better, median 0.761 -> 0.783).
 constexpr int kNoisyHeightNeighbors = 48;
