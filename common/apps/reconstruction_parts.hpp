@@ -69,8 +69,9 @@ LevelOutput flow_level(NarrowBand band, const PointIndex& index, const Reconstru
 // With settings.pierce, a region of at least kMinPierceVoxels whose lining is at least
 // kMinPierceLining below the front turns outside whole, tunnels included (a hole through a
 // plate that the shell spanned: its air meets the outside at both mouths). Nothing happens
-// with fewer than max(kMinBuried, kMinBuriedShare N) buried points, or more than kMaxBuriedShare N (then the front is not near the data at all, and
-// the candidates would be ~reach^3 voxels per point: work and memory stay bounded). The band
+// with fewer than max(kMinBuried, kMinBuriedShare N) buried points, or more than
+// kMaxBuriedShare N (then the front is not near the data at all, and the candidates would be
+// ~reach^3 voxels per point: work and memory stay bounded). The band
 // is rebuilt (the carved voxels and their face neighbours active) and redistanced when a
 // region was carved; the caller snaps the new walls onto their points.
 // Cost: O(N) band samples, O(buried * reach^3) candidate voxels and as many nearest-point
