@@ -46,21 +46,23 @@ std::uint32_t find_root(std::vector<std::uint32_t>& parent, std::uint32_t i) {
   return i;
 }
 
-// Buried: the points lying deeper than `depth` inside the band's surface.
-std::vector<std::uint32_t> buried_points(const NarrowBand& band, const PointIndex& index, double depth) {
-  const std::size_t n = index.size();
-  std::vector<std::uint8_t> flag(n, 0);
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 4096), [&](const tbb::blocked_range<std::size_t>& r) {
+// The band's value (trilinear) at every point: how deep each lies inside the surface.
+std::vector<float> point_values(const NarrowBand& band, const PointIndex& index) {
+  std::vector<float> value(index.size());
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, index.size(), 4096), [&](const tbb::blocked_range<std::size_t>& r) {
     BandAccessor acc(band);
-    for (std::size_t i = r.begin(); i != r.end(); ++i)
-      flag[i] = double(sample_trilinear(acc, band, index.points()[i])) < -depth;
+    for (std::size_t i = r.begin(); i != r.end(); ++i) value[i] = sample_trilinear(acc, band, index.points()[i]);
   });
-  std::vector<std::uint32_t> out;
-  for (std::size_t i = 0; i < n; ++i)
-    if (flag[i]) out.push_back(std::uint32_t(i));
-  return out;
+  return value;
 }
 
+// The points lying deeper than `depth` inside the surface.
+std::vector<std::uint32_t> deeper_than(const std::vector<float>& value, double depth) {
+  std::vector<std::uint32_t> out;
+  for (std::size_t i = 0; i < value.size(); ++i)
+    if (double(value[i]) < -depth) out.push_back(std::uint32_t(i));
+  return out;
+}
 
 // The band with the voxels `carved` (sorted keys) and their inside face neighbours active
 // (-h/2 where they were inactive; signs unchanged): bricks rebuilt through BandBuilder, the
@@ -132,7 +134,8 @@ CarveOutput carve_buried_gaps(NarrowBand band, const PointIndex& index, const Ca
   const double h = band.voxel_size();
   const double depth = std::max(kCarveDepthVoxels * h, kCarveNoiseDepth * s.noise);
   const double clearance = std::max({h, kCarveNoiseDepth * s.noise, s.gap});
-  const std::vector<std::uint32_t> buried = buried_points(band, index, depth);
+  const std::vector<float> value = point_values(band, index);
+  const std::vector<std::uint32_t> buried = deeper_than(value, depth);
   out.buried = buried.size();
   auto unchanged = [&] {
     out.band = std::move(band);
@@ -218,7 +221,7 @@ CarveOutput carve_buried_gaps(NarrowBand band, const PointIndex& index, const Ca
   // The lining counts the points below the front (deeper than max(1.5 h, 2 noise), not the
   // burial depth): under noise the walls of a closed gap near its mouth lie shallower than
   // 4 noise, and counting them as front points rejected the gap (CGAL's anchor at 0.5 %).
-  for (const std::uint32_t p : buried_points(band, index, std::max(kCarveDepthVoxels * h, kLiningNoiseDepth * s.noise)))
+  for (const std::uint32_t p : deeper_than(value, std::max(kCarveDepthVoxels * h, kLiningNoiseDepth * s.noise)))
     is_buried[p] = 1;
   std::vector<std::uint32_t> seen_by(index.size(), std::uint32_t(-1));
   std::vector<std::pair<std::uint32_t, double>> near;
