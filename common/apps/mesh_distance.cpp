@@ -39,32 +39,35 @@ double MeshDistance::distance(const Vec3d& p) const {
 }
 
 OneSidedDistance distances_to(const std::vector<Vec3d>& samples, const std::function<double(const Vec3d&)>& distance,
-                              const ProgressHook& progress) {
+                              const ProgressHook& progress, double gross) {
   std::vector<double> d(samples.size());
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, samples.size(), 256), [&](const tbb::blocked_range<std::size_t>& r) {
     progress.check("surface distance");
     for (std::size_t i = r.begin(); i != r.end(); ++i) d[i] = std::abs(distance(samples[i]));
   });
   OneSidedDistance o;
-  double sum = 0.0, sum2 = 0.0;
+  double sum = 0.0, sum2 = 0.0, sum_gross = 0.0;
   for (double v : d) {
     sum += v;
     sum2 += v * v;
+    if (v > gross) sum_gross += v;
     o.max = std::max(o.max, v);
   }
   if (!d.empty()) {
     o.mean = sum / double(d.size());
     o.rms = std::sqrt(sum2 / double(d.size()));
+    o.gross_mean = sum_gross / double(d.size());
   }
   return o;
 }
 
 SurfaceDistance surface_distance(const std::vector<Vec3d>& a_samples, const std::function<double(const Vec3d&)>& b_distance,
                                  const std::vector<Vec3d>& b_samples, const std::function<double(const Vec3d&)>& a_distance,
-                                 const ProgressHook& progress) {
+                                 const ProgressHook& progress, double gross) {
   SurfaceDistance s;
-  s.a_to_b = distances_to(a_samples, b_distance, progress);
-  s.b_to_a = distances_to(b_samples, a_distance, progress);
+  s.a_to_b = distances_to(a_samples, b_distance, progress, gross);
+  s.b_to_a = distances_to(b_samples, a_distance, progress, gross);
+  s.gross = 0.5 * (s.a_to_b.gross_mean + s.b_to_a.gross_mean);
   s.chamfer = 0.5 * (s.a_to_b.mean + s.b_to_a.mean);
   s.hausdorff = std::max(s.a_to_b.max, s.b_to_a.max);
   return s;

@@ -32,9 +32,10 @@ Row score(const TriangleMesh& truth, const std::vector<Vec3d>& truth_samples, co
   const apps::MeshDistance to_truth(truth), to_mesh(mesh);
   const apps::SurfaceDistance d = apps::surface_distance(
       mesh_samples, [&](const Vec3d& p) { return to_truth.distance(p); }, truth_samples,
-      [&](const Vec3d& p) { return to_mesh.distance(p); });
+      [&](const Vec3d& p) { return to_mesh.distance(p); }, {}, kGrossFraction * length(truth.bounds().extent()));
   row.chamfer = d.chamfer;
   row.hausdorff = d.hausdorff;
+  row.gross = d.gross;
   return row;
 }
 
