@@ -77,7 +77,10 @@ void run_segment_job(JobContext& ctx) {
                               std::to_string(full.nz) + " image" +
                               (factor > 1 ? " downsampled " + std::to_string(factor) + "x" : std::string()));
   }
-  ImageVolume image = read_image(path).image;
+  ImageReadOptions load;  // cancellable: a daemon's cancelled job stops inflating (per chunk of samples)
+  load.progress = ctx.options().progress;
+  load.memory_budget = o.memory_budget;
+  ImageVolume image = read_image(path, load).image;
   if (factor > 1) image = apps::downsample_image(image, factor, ctx.options().progress);
   ctx.log("input: " + path + " " + std::to_string(image.nx) + "x" + std::to_string(image.ny) + "x" +
           std::to_string(image.nz) + (factor > 1 ? " (downsampled " + std::to_string(factor) + "x)" : ""));

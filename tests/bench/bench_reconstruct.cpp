@@ -37,6 +37,7 @@ using namespace levelset;
 
 using bench::Row;
 using bench::score;
+using bench::gross_threshold;
 
 }  // namespace
 
@@ -125,7 +126,7 @@ int main(int argc, char** argv) {
             continue;
           }
           if (seed_last > seed_first) std::printf("seed %lu\n", seed);
-          const Row ours = score(truth, truth_samples, r.mesh, ours_s);
+          const Row ours = score(truth, truth_samples, r.mesh, ours_s, gross_threshold(truth, noise));
           print("levelset", ours);
           ok = ok && ours.watertight;
           if (ours_only) continue;
@@ -134,7 +135,7 @@ int main(int argc, char** argv) {
             std::printf("%-10s %7zu %6.3f%% | poisson   (reference failed: %s)\n", name, count, noise * 100, poisson.error.c_str());
             continue;
           }
-          print("poisson", score(truth, truth_samples, poisson.mesh, poisson.seconds));
+          print("poisson", score(truth, truth_samples, poisson.mesh, poisson.seconds, gross_threshold(truth, noise)));
           }
         }
       }

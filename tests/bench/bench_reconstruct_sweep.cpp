@@ -4,7 +4,7 @@
 // diagonal; the same points for both. Per case: Chamfer and Hausdorff (printed over the
 // diagonal; world units in the --jsonl records, with the diagonal and our coverage),
 // watertight, genus, components (against the true mesh's), seconds, and the share of each
-// Chamfer carried by gross errors (distances above kGrossFraction of the diagonal: missed or
+// Chamfer carried by gross errors (distances above max(0.5 %, 3 noise) of the diagonal: missed or
 // fused parts, closed gaps). Then a summary: wins and losses on Chamfer, the median ratio, the
 // losses that the gross errors decide (ours ahead once each side's gross part is taken out),
 // topology failures both ways, time.
@@ -284,7 +284,7 @@ CaseResult run_case(const SweepMesh& m, const std::vector<Vec3d>& truth_samples,
   try {
     const apps::ReconstructionResult r = apps::reconstruct_surface(points, ro);
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    c.ours = score(m.mesh, truth_samples, r.mesh, seconds);
+    c.ours = score(m.mesh, truth_samples, r.mesh, seconds, gross_threshold(m.mesh, noise));
     c.ours_resolution = r.resolution;
     c.ours_coverage = r.coverage;
     if (!o.keep.empty()) {
@@ -305,7 +305,7 @@ CaseResult run_case(const SweepMesh& m, const std::vector<Vec3d>& truth_samples,
     std::snprintf(key, sizeof key, "%s-%zu-%g-%u", m.name.c_str(), count, noise, seed);
     const PoissonRun p = run_poisson(points, (fs::path(o.cache) / key).string());
     if (p.ok) {
-      c.poisson = score(m.mesh, truth_samples, p.mesh, p.seconds);
+      c.poisson = score(m.mesh, truth_samples, p.mesh, p.seconds, gross_threshold(m.mesh, noise));
       c.has_poisson = true;
     } else {
       std::printf("  %s: poisson failed: %s\n", m.name.c_str(), p.error.c_str());
@@ -353,7 +353,7 @@ int run_reconstruct_sweep(int argc, char** argv) {
                 m.mesh.triangles.size(), m.measures.genus, static_cast<unsigned long long>(m.measures.components),
                 100 * m.thin, m.thin > 0.005 ? " (features thinner than 2 voxels: marked T)" : "");
   if (o.list_only) return 0;
-  // gross: the share of each Chamfer carried by distances above kGrossFraction of the diagonal.
+  // gross: the share of each Chamfer carried by distances above gross_threshold (reconstruct_scoring.hpp).
   std::printf("%-24s %7s %6s %3s | %9s %9s %6s | %9s | %9s %9s | %-14s %-14s %-6s | %6s %6s\n", "mesh", "points", "noise",
               "sd", "ours_ch/D", "pois_ch/D", "ratio", "gross o p", "ours_hd/D", "pois_hd/D", "ours topo", "poisson topo",
               "truth", "ours_s", "pois_s");

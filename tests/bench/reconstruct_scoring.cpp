@@ -1,5 +1,6 @@
 #include "reconstruct_scoring.hpp"
 
+#include <algorithm>
 #include <array>
 #include <cstdio>
 #include <filesystem>
@@ -17,7 +18,12 @@
 
 namespace levelset::bench {
 
-Row score(const TriangleMesh& truth, const std::vector<Vec3d>& truth_samples, const TriangleMesh& mesh, double seconds) {
+double gross_threshold(const TriangleMesh& truth, double noise) {
+  return std::max(kGrossFraction, kGrossNoise * noise) * length(truth.bounds().extent());
+}
+
+Row score(const TriangleMesh& truth, const std::vector<Vec3d>& truth_samples, const TriangleMesh& mesh, double seconds,
+          double gross) {
   const MeshMeasures m = measure_mesh(mesh);
   Row row;
   row.seconds = seconds;
@@ -32,7 +38,7 @@ Row score(const TriangleMesh& truth, const std::vector<Vec3d>& truth_samples, co
   const apps::MeshDistance to_truth(truth), to_mesh(mesh);
   const apps::SurfaceDistance d = apps::surface_distance(
       mesh_samples, [&](const Vec3d& p) { return to_truth.distance(p); }, truth_samples,
-      [&](const Vec3d& p) { return to_mesh.distance(p); }, {}, kGrossFraction * length(truth.bounds().extent()));
+      [&](const Vec3d& p) { return to_mesh.distance(p); }, {}, gross);
   row.chamfer = d.chamfer;
   row.hausdorff = d.hausdorff;
   row.gross = d.gross;

@@ -12,22 +12,26 @@
 
 namespace levelset::bench {
 
-// Distances above this fraction of the truth's bounding-box diagonal are gross errors (a
-// missed or fused part, a closed gap), not a fit's inaccuracy: Row::gross is the part of the
-// Chamfer they carry.
+// Distances above max(kGrossFraction, kGrossNoise noise) of the truth's bounding-box diagonal
+// (noise: the points' sigma as a fraction of it) are gross errors (a missed or fused part, a
+// closed gap), not a fit's inaccuracy or the noise's: Row::gross is the part of the Chamfer
+// they carry.
 constexpr double kGrossFraction = 5e-3;
+constexpr double kGrossNoise = 3.0;
+double gross_threshold(const TriangleMesh& truth, double noise);
 
 struct Row {
   double chamfer = 0, hausdorff = 0, seconds = 0, genus = 0;
-  double gross = 0;  // the part of chamfer carried by distances above kGrossFraction of the diagonal
+  double gross = 0;  // the part of chamfer carried by distances above the gross threshold
   bool watertight = false;
   std::uint64_t components = 0;
 };
 
 // Symmetric mean (Chamfer) and max (Hausdorff) of exact point-to-mesh distances between 200k
-// area samples of `mesh` and the given samples of the truth, the Chamfer's gross part;
-// watertight, genus, components.
-Row score(const TriangleMesh& truth, const std::vector<Vec3d>& truth_samples, const TriangleMesh& mesh, double seconds);
+// area samples of `mesh` and the given samples of the truth, the Chamfer's part above `gross`
+// (world; gross_threshold); watertight, genus, components.
+Row score(const TriangleMesh& truth, const std::vector<Vec3d>& truth_samples, const TriangleMesh& mesh, double seconds,
+          double gross);
 
 struct PoissonRun {
   bool ok = false;

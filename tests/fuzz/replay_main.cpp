@@ -7,8 +7,8 @@
 // or hostile numbers, splices of two seeds.
 // Prints "<N> inputs, 0 crashes" and returns 0. Returns 1 (after printing the input, escaped
 // and truncated) when an exception escapes the target (the targets catch levelset::Error, so
-// anything escaping is a bug) or one input takes longer than 2 s (a hang: a watchdog thread
-// reports it and exits even if the input never finishes). A crash (signal) prints which input
+// anything escaping is a bug) or one input takes longer than 2 s in two runs in a row (a slow
+// path; a watchdog thread reports a hang, 5 s, and exits even if the input never finishes). A crash (signal) prints which input
 // was running and the input, then dies with the signal.
 #include <unistd.h>
 #include <algorithm>
@@ -209,8 +209,9 @@ class Mutator {
   std::mt19937_64 rng_;
 };
 
-// Runs one input; false (after printing why) on an escaped exception or a hang.
-bool run_one(const std::string& input, std::uint64_t index, std::string_view label) {
+// Runs one input once: its wall-clock seconds, or a negative value (after printing why) when an
+// exception escaped.
+double timed_run(const std::string& input, std::uint64_t index, std::string_view label) {
   g_current = &input;
   g_current_index = index;
   const auto start = std::chrono::steady_clock::now();
@@ -221,20 +222,31 @@ bool run_one(const std::string& input, std::uint64_t index, std::string_view lab
     std::fprintf(stderr, "FAIL: input #%llu (%.*s) threw %s: %s\ninput: %s\n",
                  static_cast<unsigned long long>(index), static_cast<int>(label.size()),
                  label.data(), typeid(e).name(), e.what(), escaped(input).c_str());
-    return false;
+    return -1.0;
   } catch (...) {
     std::fprintf(stderr, "FAIL: input #%llu (%.*s) threw a non-std exception\ninput: %s\n",
                  static_cast<unsigned long long>(index), static_cast<int>(label.size()),
                  label.data(), escaped(input).c_str());
-    return false;
+    return -1.0;
   }
   g_started_ns.store(0);
-  const double seconds =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  if (seconds > kMaxSecondsPerInput) {
-    std::fprintf(stderr, "FAIL: input #%llu (%.*s) took %.2f s (limit %.1f s)\ninput: %s\n",
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+// Runs one input; false (after printing why) on an escaped exception or a hang. An input over
+// the time limit runs once more and fails only when that run is over it as well: a hang or a
+// slow path repeats, a moment of load on a shared machine (the 2-core CI running tests side by
+// side) does not (fuzz_job once took 2.02 s there with both cores busy).
+bool run_one(const std::string& input, std::uint64_t index, std::string_view label) {
+  const double first = timed_run(input, index, label);
+  if (first < 0.0) return false;
+  if (first <= kMaxSecondsPerInput) return true;
+  const double again = timed_run(input, index, label);
+  if (again < 0.0) return false;
+  if (again > kMaxSecondsPerInput) {
+    std::fprintf(stderr, "FAIL: input #%llu (%.*s) took %.2f s and %.2f s (limit %.1f s)\ninput: %s\n",
                  static_cast<unsigned long long>(index), static_cast<int>(label.size()),
-                 label.data(), seconds, kMaxSecondsPerInput, escaped(input).c_str());
+                 label.data(), first, again, kMaxSecondsPerInput, escaped(input).c_str());
     return false;
   }
   return true;

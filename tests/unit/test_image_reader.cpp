@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "core/error.hpp"
+#include "core/progress.hpp"
 #include "io/image_reader.hpp"
 #include "reader_test_support.hpp"
 
@@ -112,6 +113,26 @@ TEST(ImageReader, InrHeaderNotPaddedAndGzip) {
   const std::string whole = inr_header(kInrU8) + data;
   const ImageReadResult two = read_image_from_memory(gzip(whole.substr(0, 100)) + gzip(whole.substr(100)), "q.inr.gz");
   EXPECT_EQ(two.image.samples, z.image.samples);
+}
+
+TEST(ImageReader, ACancelDuringTheSamplesEndsTheReadWithinAChunk) {
+  // 128^3 gzip samples (2M, under one progress report of 2^24): the token fires at the first
+  // report, after the first chunk. The read must end there with Error{Cancelled} (a daemon's
+  // cancelled job stops inflating), not run to the end as when only the reports checked.
+  const std::string fields = "XDIM=128\nYDIM=128\nZDIM=128\nVDIM=1\nTYPE=unsigned fixed\nPIXSIZE=8 bits\nSCALE=2**0\nCPU=decm\n";
+  const std::string bytes = gzip(inr_header(fields) + std::string(std::size_t{128} * 128 * 128, '\x07'));
+  auto token = std::make_shared<CancelToken>();
+  int reports = 0;
+  ImageReadOptions o;
+  o.progress.cancel = token;
+  o.progress.on_progress = [&](double, std::string_view) {
+    ++reports;
+    token->cancel();
+  };
+  EXPECT_TRUE(fails(bytes, "c.inr.gz", ErrorCode::Cancelled, "image", o));
+  EXPECT_EQ(reports, 1);
+  // Without the cancel the same bytes read whole.
+  EXPECT_EQ(read_image_from_memory(bytes, "c.inr.gz").image.samples.size(), std::size_t{128} * 128 * 128);
 }
 
 TEST(ImageReader, InrErrors) {
