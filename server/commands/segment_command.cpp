@@ -84,7 +84,10 @@ int run_segment(const SegmentArgs& a) {
   header_only.samples = ImageSamples::Skip;
   const ImageReadResult header = read_image(a.image, header_only);
   apps::require_segmentation_budget(header.image, header.file_bytes, o, a.image);
-  const ImageReadResult in = read_image(a.image);
+  ImageReadOptions load;  // the samples under the same budget as the segmentation (--memory-budget)
+  load.memory_budget = o.memory_budget;
+  load.progress = o.progress;
+  const ImageReadResult in = read_image(a.image, load);
   const auto t1 = std::chrono::steady_clock::now();
   const apps::SegmentationResult r = apps::segment_image(in.image, o);
   const auto t2 = std::chrono::steady_clock::now();
