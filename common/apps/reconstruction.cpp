@@ -231,6 +231,7 @@ ReconstructionResult reconstruct_surface(const std::vector<Vec3d>& input, const 
       where.carve.noise = result.sampling.noise;
       where.carve.gap = gap;
       where.carve.pierce = o.pierce_tunnels;
+      where.carve.narrow = o.narrow_gaps;
       detail::SnapOutput snapped = detail::snap_level(std::move(band), *index, o, where, std::move(stage), noise);
       band = std::move(snapped.band);
       stage = std::move(snapped.stage);

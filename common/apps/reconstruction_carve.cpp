@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstdint>
 #include <iterator>
+#include <limits>
 #include <numeric>
 #include <vector>
 
@@ -126,14 +127,18 @@ NarrowBand with_active(const NarrowBand& band, const std::vector<std::uint64_t>&
   return builder.finish(band.far_inside());
 }
 
-}  // namespace
+// Empty space farther than this from every point may be carved.
+double clearance_of(const CarveSettings& s, double h) { return std::max({h, kCarveNoiseDepth * s.noise, s.gap}); }
 
-CarveOutput carve_buried_gaps(NarrowBand band, const PointIndex& index, const CarveSettings& s,
-                              const ProgressHook& progress) {
+// One carving (see reconstruction_parts.hpp) with the given settings; its candidates lie no
+// farther than `outer` from every point (the narrow carving leaves the space beyond the first
+// one's clearance, which that carving has judged, alone).
+CarveOutput carve_once(NarrowBand band, const PointIndex& index, const CarveSettings& s, double outer,
+                       const ProgressHook& progress) {
   CarveOutput out;
   const double h = band.voxel_size();
   const double depth = std::max(kCarveDepthVoxels * h, kCarveNoiseDepth * s.noise);
-  const double clearance = std::max({h, kCarveNoiseDepth * s.noise, s.gap});
+  const double clearance = clearance_of(s, h);
   const std::vector<float> value = point_values(band, index);
   const std::vector<std::uint32_t> buried = deeper_than(value, depth);
   out.buried = buried.size();
@@ -183,8 +188,10 @@ CarveOutput carve_buried_gaps(NarrowBand band, const PointIndex& index, const Ca
   std::vector<std::uint8_t> clear(keys.size(), 0);
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, keys.size(), 1024), [&](const tbb::blocked_range<std::size_t>& r) {
     progress.check("reconstruct carve");
-    for (std::size_t i = r.begin(); i != r.end(); ++i)
-      clear[i] = index.nearest(band.world(coord_of(keys[i]))).distance > clearance;
+    for (std::size_t i = r.begin(); i != r.end(); ++i) {
+      const double d = index.nearest(band.world(coord_of(keys[i]))).distance;
+      clear[i] = d > clearance && d <= outer;
+    }
   });
   std::vector<std::uint64_t> air;
   for (std::size_t i = 0; i < keys.size(); ++i)
@@ -315,6 +322,27 @@ CarveOutput carve_buried_gaps(NarrowBand band, const PointIndex& index, const Ca
   redo.half_width = band.half_width();
   redo.progress = progress;
   out.band = redistance(reframed(out.band, {}, 1.0), redo).band;
+  return out;
+}
+
+}  // namespace
+
+CarveOutput carve_buried_gaps(NarrowBand band, const PointIndex& index, const CarveSettings& s,
+                              const ProgressHook& progress) {
+  const double h = band.voxel_size();
+  CarveOutput out = carve_once(std::move(band), index, s, std::numeric_limits<double>::infinity(), progress);
+  if (!s.narrow) return out;
+  // The narrow gaps (see kNarrowGapClearance), after the wide ones are open: simple flips only.
+  CarveSettings narrow = s;
+  narrow.gap *= kNarrowGapClearance;
+  narrow.pierce = false;
+  CarveOutput more = carve_once(std::move(out.band), index, narrow, clearance_of(s, h), progress);
+  out.band = std::move(more.band);
+  out.regions += more.regions;
+  out.carved_voxels += more.carved_voxels;
+  out.bricks.insert(out.bricks.end(), more.bricks.begin(), more.bricks.end());
+  std::sort(out.bricks.begin(), out.bricks.end());
+  out.bricks.erase(std::unique(out.bricks.begin(), out.bricks.end()), out.bricks.end());
   return out;
 }
 
