@@ -336,6 +336,8 @@ CarveOutput carve_buried_gaps(NarrowBand band, const PointIndex& index, const Ca
   CarveSettings narrow = s;
   narrow.gap *= kNarrowGapClearance;
   narrow.pierce = false;
+  // Nothing to look at where the noise or the voxel, not the gap, sets the clearance.
+  if (!(clearance_of(narrow, h) < clearance_of(s, h))) return out;
   CarveOutput more = carve_once(std::move(out.band), index, narrow, clearance_of(s, h), progress);
   out.band = std::move(more.band);
   out.regions += more.regions;
