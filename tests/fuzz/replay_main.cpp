@@ -8,8 +8,8 @@
 // Prints "<N> inputs, 0 crashes" and returns 0. Returns 1 (after printing the input, escaped
 // and truncated) when an exception escapes the target (the targets catch levelset::Error, so
 // anything escaping is a bug) or one input takes longer than 2 s in two runs in a row (a slow
-// path; a watchdog thread reports a hang, 5 s, and exits even if the input never finishes). A crash (signal) prints which input
-// was running and the input, then dies with the signal.
+// path; a watchdog thread reports a hang, 5 s, and exits even if the input never finishes).
+// A crash (signal) prints which input was running and the input, then dies with the signal.
 #include <unistd.h>
 #include <algorithm>
 #include <atomic>
