@@ -130,18 +130,32 @@ LocalFit one_sided_fit(const PointIndex& index, const Vec3d& x, const Vec3d& n, 
 // least 32 kept points a second quadric over the nearest half is fitted, and its offset taken
 // where the two differ by more than 1.5 of its standard errors (the large patch bent by detail
 // the quadric cannot follow; intersection of confidence intervals, Lepski).
+// noise (HeightNoise): noise.sigma (world, the points' noise per axis, 0: none assumed): the
+// points' tangential coordinates carry it too, which biases a regressed height by sigma^2 / 2
+// times the surface's Laplacian (a curved patch's fit lies toward its concave side by
+// ~H sigma^2, H the mean curvature); c0 is corrected by that, at most by sigma / 2. With
+// noise.select the height fit's points are also chosen without a bias toward the tangent
+// plane: the band is at least 3 sigma, and the points lie in a tangential disc the k_height
+// ball holds whole (a ball cuts the slab's corners, so it keeps a curved patch's rim points
+// by their height; the disc costs a quarter of the points, which pays only under strong noise).
 // has_height is false (height_offset 0) with fewer than 10
 // kept points or an ill-conditioned system. Thread-safe.
+struct HeightNoise {
+  double sigma = 0.0;   // world
+  bool select = false;  // points chosen without a bias toward the tangent plane
+};
 struct SheetFit {
   LocalFit plane;
   double height_offset = 0.0;
   double height_residual = 0.0;  // the quadric's weighted RMS residual (world): a noise estimate
   bool has_height = false;
 };
-SheetFit sheet_fit(const PointIndex& index, const Vec3d& x, const Vec3d& n, int k, int k_height, double min_band);
+SheetFit sheet_fit(const PointIndex& index, const Vec3d& x, const Vec3d& n, int k, int k_height, double min_band,
+                   HeightNoise noise = {});
 // The same, its k nearest points from a neighbourhood prepared around x (apps/nearby_points.hpp).
 class NearbyPoints;
-SheetFit sheet_fit(const NearbyPoints& near, const Vec3d& x, const Vec3d& n, int k, int k_height, double min_band);
+SheetFit sheet_fit(const NearbyPoints& near, const Vec3d& x, const Vec3d& n, int k, int k_height, double min_band,
+                   HeightNoise noise = {});
 
 // A sheet fit made once at x and evaluated at positions y near it (the voxels of a small block
 // can share one fit). at(y): the plane fit's moments moved to y (a and S are moments about the
@@ -160,7 +174,8 @@ struct SheetModel {
   double patch_radius() const { return inv_r > 0.0 ? 1.0 / inv_r : 0.0; }
   SheetFit at(const Vec3d& y) const;
 };
-SheetModel sheet_model(const NearbyPoints& near, const Vec3d& x, const Vec3d& n, int k, int k_height, double min_band);
+SheetModel sheet_model(const NearbyPoints& near, const Vec3d& x, const Vec3d& n, int k, int k_height, double min_band,
+                       HeightNoise noise = {});
 
 struct PointFitFieldOptions {
   int neighbors = 8;  // k

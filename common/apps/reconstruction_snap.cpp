@@ -234,6 +234,7 @@ struct FitSettings {
   int neighbors, height_neighbors;
   double min_band;      // world
   double share_radius;  // world: columns share a fit whose quadric patch is at least this wide
+  HeightNoise noise;    // the points' noise, which the height fits correct for (sheet_fit)
 };
 
 // The sheet fit of every voxel (fits[v] for voxels[v]). The voxels of one column along the
@@ -256,7 +257,7 @@ void fit_voxels(const NearbyPoints& near, const std::vector<FitVoxel>& voxels, c
   for (std::size_t v = 0; v < voxels.size(); ++v) by_column[std::size_t(fill[std::size_t(voxels[v].column)]++)] = int(v);
   auto own = [&](int v) {
     fits[std::size_t(v)] = sheet_fit(near, voxels[std::size_t(v)].x, voxels[std::size_t(v)].n, fs.neighbors,
-                                     fs.height_neighbors, fs.min_band);
+                                     fs.height_neighbors, fs.min_band, fs.noise);
   };
   bool share = true;
   for (int k = 0; k < kColumns; ++k) {
@@ -273,7 +274,7 @@ void fit_voxels(const NearbyPoints& near, const std::vector<FitVoxel>& voxels, c
       continue;
     }
     const SheetModel model = sheet_model(near, centroid / double(count), normal / nl, fs.neighbors,
-                                         fs.height_neighbors, fs.min_band);
+                                         fs.height_neighbors, fs.min_band, fs.noise);
     if (model.has_height && model.patch_radius() < fs.share_radius) {
       share = false;
       for (int j = begin; j < end; ++j) own(by_column[std::size_t(j)]);
@@ -291,6 +292,7 @@ struct SnapSettings {
   int height_neighbors = kHeightNeighbors;  // height fits
   double height_guard = kHeightGuard;  // voxels: height fits within this of the plane fit's are used
   bool noisy_height = false;     // noisy data: the height fits' offsets as well (see kNoisyHeightNeighbors)
+  double noise = 0.0;            // world: the points' noise the previous pass measured, beyond kResidualFloor
   double window = kSnapWindow;   // voxels that move
   double fit_window = kFitWindow;  // voxels with their own fit (within the window)
   double h_final = 0.0;
@@ -308,7 +310,8 @@ SnapPass snap_to_fits(NarrowBand& band, const PointIndex& index, const SnapSetti
   const int neighbors = settings.neighbors;
   const bool same_grid = coarse.voxel_size() == h;  // a single level: its own curvature
   const float unset = std::numeric_limits<float>::quiet_NaN();
-  const FitSettings fit_settings{neighbors, settings.height_neighbors, kOneSidedBand * h, kShareRadius * h};
+  const FitSettings fit_settings{neighbors, settings.height_neighbors, kOneSidedBand * h, kShareRadius * h,
+                                 {settings.noise, settings.noisy_height}};
   // 1. The front offset e = clamp(s - u, +-h) of every voxel within the window.
   std::vector<float> offset(band.active_voxel_count(), unset);
   std::vector<std::uint8_t> moves(band.active_voxel_count(), 0);  // within the window
@@ -501,6 +504,8 @@ SnapOutput snap_level(NarrowBand band, const PointIndex& index, const Reconstruc
                                                                 previous_height_noise));
     }
     settings.height_guard = std::max(kHeightGuard, kHeightGuardNoise * previous_height_noise * h_final / h);
+    settings.noise = std::sqrt(std::max(0.0, previous_height_noise * previous_height_noise -
+                                                 kResidualFloor * kResidualFloor)) * h_final;
     settings.window = refine ? kRefineWindow : kSnapWindow;
     settings.fit_window = refine ? kRefineWindow : kFitWindow;
     settings.h_final = h_final;
