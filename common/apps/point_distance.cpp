@@ -390,6 +390,19 @@ HeightFit quadric_height(const TangentPoint* pts, int used, double noise) {
     for (int a = 0; a < 6; ++a)
       for (int b = 0; b < 6; ++b) var += y[std::size_t(a)] * S[std::size_t(a * 6 + b)] * y[std::size_t(b)];
   }
+  // The quadric's weighted residual: the points' noise, free of the surface's curvature
+  // (which the quadric absorbs), corrected for the 6 fitted coefficients; about the fitted c0,
+  // before the noise correction below moves it.
+  double wsum = 0.0, rsum = 0.0;
+  for (int i = 0; i < used; ++i) {
+    const double u = pts[i].xi * inv_r, v = pts[i].eta * inv_r;
+    const double w = weight[std::size_t(i)];
+    const double z = r[0] + r[1] * u + r[2] * v + r[3] * u * u + r[4] * u * v + r[5] * v * v;
+    const double e = pts[i].z - z;
+    wsum += w;
+    rsum += w * e * e;
+  }
+  f.residual = std::sqrt(rsum / (wsum * (1.0 - 6.0 / double(used))));
   // Errors in the tangential coordinates: a point seen at (xi, eta) was sampled about
   // N((xi, eta), noise^2) on the surface, so the heights regressed there are the surface's
   // plus noise^2 / 2 times its Laplacian, and c0 carries (c3 + c5) noise^2 / R^2: the fitted
@@ -407,18 +420,6 @@ HeightFit quadric_height(const TangentPoint* pts, int used, double noise) {
   f.spread = std::sqrt(std::max(0.0, var));
   f.c = r;
   f.inv_r = inv_r;
-  // The quadric's weighted residual: the points' noise, free of the surface's curvature
-  // (which the quadric absorbs), corrected for the 6 fitted coefficients.
-  double wsum = 0.0, rsum = 0.0;
-  for (int i = 0; i < used; ++i) {
-    const double u = pts[i].xi * inv_r, v = pts[i].eta * inv_r;
-    const double w = weight[std::size_t(i)];
-    const double z = r[0] + r[1] * u + r[2] * v + r[3] * u * u + r[4] * u * v + r[5] * v * v;
-    const double e = pts[i].z - z;
-    wsum += w;
-    rsum += w * e * e;
-  }
-  f.residual = std::sqrt(rsum / (wsum * (1.0 - 6.0 / double(used))));
   f.ok = true;
   return f;
 }
@@ -432,28 +433,38 @@ namespace {
 // that band is at least kNoiseBand sigma (the 8 nearest points' spread reads the noise ~15 %
 // low and a flat slab cuts the sagitta's side of a curved patch's rim: both lift the rim and
 // sink the fit, and the residual then under-reads the noise), and only the points inside the
-// widest tangential disc whose slab the k_height ball holds whole are kept: past it the ball
-// keeps a point by its height as well, again the rim's points nearest the tangent plane.
-// Returns how many were written.
-int height_points(const PointIndex& index, const Vec3d& x, const Vec3d& n, const Vec3d& e1, const Vec3d& e2, Sheet& sh,
-                  int k_height, const HeightNoise& noise, std::array<TangentPoint, kMaxNeighbors>& pts) {
+// widest tangential disc whose slab the k_height ball holds whole are kept, at least half of
+// the band's (past that disc the ball keeps a point by its height as well, again the rim's
+// points nearest the tangent plane). Returns how many were written.
+int height_points(const PointIndex& index, const Vec3d& x, const Vec3d& n, const Vec3d& e1, const Vec3d& e2,
+                  const Sheet& sh, int k_height, const HeightNoise& noise,
+                  std::array<TangentPoint, kMaxNeighbors>& pts) {
   const int count = std::min(k_height, sh.count);
-  double disc2 = std::numeric_limits<double>::infinity();
-  if (noise.select && noise.sigma > 0.0 && count > 0) {
-    sh.band = std::max(sh.band, kNoiseBand * noise.sigma);
-    const double reach = std::abs(sh.ref) + sh.band;
-    disc2 = sh.d2[std::size_t(count - 1)] - reach * reach;
-    if (!(disc2 > 0.0)) disc2 = std::numeric_limits<double>::infinity();  // the ball is thinner than the slab
-  }
+  const bool select = noise.select && noise.sigma > 0.0 && count > 0;
+  const double band = select ? std::max(sh.band, kNoiseBand * noise.sigma) : sh.band;
   int used = 0;
   for (int i = 0; i < count; ++i) {
-    if (std::abs(sh.t[std::size_t(i)] - sh.ref) > sh.band) continue;
+    if (std::abs(sh.t[std::size_t(i)] - sh.ref) > band) continue;
     const Vec3d v = index.points()[sh.idx[std::size_t(i)]] - x;
-    const TangentPoint p{dot(v, e1), dot(v, e2), dot(v, n)};
-    if (p.xi * p.xi + p.eta * p.eta > disc2) continue;
-    pts[std::size_t(used++)] = p;
+    pts[std::size_t(used++)] = TangentPoint{dot(v, e1), dot(v, e2), dot(v, n)};
   }
-  return used;
+  if (!select || used < 2) return used;
+  // The disc, widened where it would keep fewer than half the band's points; the ball's order
+  // kept (the scale choice's smaller patch is the nearer half of it).
+  std::array<double, kMaxNeighbors> radius2, sorted;
+  for (int i = 0; i < used; ++i) {
+    const TangentPoint& p = pts[std::size_t(i)];
+    radius2[std::size_t(i)] = sorted[std::size_t(i)] = p.xi * p.xi + p.eta * p.eta;
+  }
+  const double reach = std::abs(sh.ref) + band;
+  double disc2 = sh.d2[std::size_t(count - 1)] - reach * reach;
+  const auto half = sorted.begin() + (used - 1) / 2;
+  std::nth_element(sorted.begin(), half, sorted.begin() + used);
+  disc2 = std::max(disc2, *half);
+  int kept = 0;
+  for (int i = 0; i < used; ++i)
+    if (radius2[std::size_t(i)] <= disc2) pts[std::size_t(kept++)] = pts[std::size_t(i)];
+  return kept;
 }
 
 SheetModel sheet_model_from(const PointIndex& index, const NearbyPoints* near, const Vec3d& x, const Vec3d& n, int k,

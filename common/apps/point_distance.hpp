@@ -117,33 +117,38 @@ LocalFit local_fit(const PointIndex& index, const Vec3d& x, int k);
 // marching-cubes topology followed the noise). Thread-safe.
 LocalFit one_sided_fit(const PointIndex& index, const Vec3d& x, const Vec3d& n, int k, double min_band);
 
+// How the height fit treats the points' noise (sheet_fit). sigma (world, per axis; 0: none
+// assumed): the points' tangential coordinates carry it too, which biases a regressed height by
+// sigma^2 / 2 times the surface's Laplacian (a curved patch's fit lies toward its concave side by
+// ~H sigma^2, H the mean curvature); c0 is corrected by that, at most by sigma / 2. select: the
+// height fit's points are chosen without a bias toward the tangent plane: the band is at least
+// 3 sigma, and the points lie in a tangential disc the k_height ball holds whole (a ball cuts the
+// slab's corners, so it keeps a curved patch's rim points by their height). The scale choice's
+// smaller patch stays the 3D-nearest half (a disc there measured 1-2 % worse on smooth shapes
+// at 0.5 % noise, bench_reconstruct --sweep). The disc keeps at least half the band's points
+// (where the ball is barely wider than the slab, a smaller disc would leave the fit too few);
+// it costs a quarter of them under 0.5 % noise, which pays only where the noise is strong.
+struct HeightNoise {
+  double sigma = 0.0;   // world
+  bool select = false;  // points chosen without a bias toward the tangent plane
+};
+
 // The one-sided fit of the first k points and a second-order fit of the first k_height
-// (both trimmed to the near sheet as one_sided_fit): in the frame of the unit normal n at x,
+// (both trimmed to the near sheet as one_sided_fit; the height fit as `noise` says): in the
+// frame of the unit normal n at x,
 // the height z = c0 + c1 xi + c2 eta + c3 xi^2 + c4 xi eta + c5 eta^2 of the points above the
 // tangent plane, by least squares weighted exp(-rho^2 / R^2) (rho the tangential distance
 // from x, R the largest among the kept points). height_offset = -c0 / sqrt(1 + |grad z|^2)
 // is x's signed distance to that quadric: no bias from the surface's curvature (the plane /
 // centroid fit's O(rho^2 H)) and no dependence on where the points lie around x, so it
 // needs no curvature correction; height_residual, the weighted RMS of the points' heights
-// about the quadric (times sqrt(n / (n - 6))), estimates the noise without the curvature's
-// sagitta that the plane fit's spread carries. The patch's scale follows the data: with at
-// least 32 kept points a second quadric over the nearest half is fitted, and its offset taken
-// where the two differ by more than 1.5 of its standard errors (the large patch bent by detail
-// the quadric cannot follow; intersection of confidence intervals, Lepski).
-// noise (HeightNoise): noise.sigma (world, the points' noise per axis, 0: none assumed): the
-// points' tangential coordinates carry it too, which biases a regressed height by sigma^2 / 2
-// times the surface's Laplacian (a curved patch's fit lies toward its concave side by
-// ~H sigma^2, H the mean curvature); c0 is corrected by that, at most by sigma / 2. With
-// noise.select the height fit's points are also chosen without a bias toward the tangent
-// plane: the band is at least 3 sigma, and the points lie in a tangential disc the k_height
-// ball holds whole (a ball cuts the slab's corners, so it keeps a curved patch's rim points
-// by their height; the disc costs a quarter of the points, which pays only under strong noise).
-// has_height is false (height_offset 0) with fewer than 10
-// kept points or an ill-conditioned system. Thread-safe.
-struct HeightNoise {
-  double sigma = 0.0;   // world
-  bool select = false;  // points chosen without a bias toward the tangent plane
-};
+// about the quadric (times sqrt(n / (n - 6)); before the noise correction of c0), estimates the
+// noise without the curvature's sagitta that the plane fit's spread carries. The patch's scale
+// follows the data: with at least 32 kept points a second quadric over the nearest half is
+// fitted, and its offset taken where the two differ by more than 1.5 of its standard errors
+// (the large patch bent by detail the quadric cannot follow; intersection of confidence
+// intervals, Lepski). has_height is false (height_offset 0) with fewer than 10 kept points or
+// an ill-conditioned system. Thread-safe.
 struct SheetFit {
   LocalFit plane;
   double height_offset = 0.0;
