@@ -528,6 +528,7 @@ SheetFit SheetModel::at(const Vec3d& y) const {
   const double zu = c[1] + 2.0 * c[3] * u + c[4] * v, zv = c[2] + c[4] * u + 2.0 * c[5] * v;
   const double slope2 = (zu * zu + zv * zv) * inv_r * inv_r;
   f.height_offset = -(z - zeta) / std::sqrt(1.0 + slope2);
+  f.noise_gain = (c[3] + c[5]) * inv_r * inv_r / std::sqrt(1.0 + slope2);
   f.height_residual = height_residual;
   f.has_height = true;
   return f;

@@ -153,6 +153,9 @@ struct SheetFit {
   LocalFit plane;
   double height_offset = 0.0;
   double height_residual = 0.0;  // the quadric's weighted RMS residual (world): a noise estimate
+  // d height_offset / d sigma^2 of the noise correction (1 / world): the offset for another
+  // sigma is height_offset + noise_gain (sigma'^2 - sigma^2), within the correction's bound.
+  double noise_gain = 0.0;
   bool has_height = false;
 };
 SheetFit sheet_fit(const PointIndex& index, const Vec3d& x, const Vec3d& n, int k, int k_height, double min_band,

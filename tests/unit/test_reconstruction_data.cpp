@@ -18,6 +18,7 @@
 #include "core/error.hpp"
 #include "geometry/analytic_shapes.hpp"
 #include "io/mesh_reader.hpp"
+#include "noisy_torus.hpp"
 
 namespace levelset::apps {
 namespace {
@@ -127,19 +128,8 @@ TEST(SheetFit, TangentialNoiseDoesNotSinkACurvedSurface) {
 TEST(SheetFit, NoisyTubeFitsAreNotSunk) {
   const double R = 1.0, r = 0.15;
   const double sigma = 0.005 * std::sqrt(2.0 * 4.0 * (R + r) * (R + r) + 4.0 * r * r);
-  std::mt19937_64 rng(4);
-  std::uniform_real_distribution<double> angle(0.0, 2.0 * M_PI), unit(0.0, 1.0);
-  std::normal_distribution<double> g(0.0, sigma);
-  auto on_torus = [&](double phi, double theta) {
-    return Vec3d{(R + r * std::cos(theta)) * std::cos(phi), (R + r * std::cos(theta)) * std::sin(phi),
-                 r * std::sin(theta)};
-  };
-  std::vector<Vec3d> points;
-  while (points.size() < 20000) {
-    const double phi = angle(rng), theta = angle(rng);
-    if (unit(rng) * (R + r) > R + r * std::cos(theta)) continue;  // area element ~ R + r cos(theta)
-    points.push_back(on_torus(phi, theta) + Vec3d{g(rng), g(rng), g(rng)});
-  }
+  const std::vector<Vec3d> points = test::noisy_torus_points(R, r, 20000, sigma, 4);
+  std::uniform_real_distribution<double> angle(0.0, 2.0 * M_PI);
   const PointIndex index(points);
   auto mean_fit = [&](HeightNoise noise) {
     std::mt19937_64 at(9);
@@ -148,7 +138,7 @@ TEST(SheetFit, NoisyTubeFitsAreNotSunk) {
     for (int i = 0; i < 1000; ++i) {
       const double phi = angle(at), theta = angle(at);
       const Vec3d normal{std::cos(theta) * std::cos(phi), std::cos(theta) * std::sin(phi), std::sin(theta)};
-      const SheetFit f = sheet_fit(index, on_torus(phi, theta), normal, 8, 165, 0.02, noise);
+      const SheetFit f = sheet_fit(index, test::torus_point(R, r, phi, theta), normal, 8, 165, 0.02, noise);
       if (!f.has_height) continue;
       offset += f.height_offset;
       residual += f.height_residual;
