@@ -416,8 +416,8 @@ SnapPass snap_to_fits(NarrowBand& band, const PointIndex& index, const SnapSetti
   // bench_reconstruct --sweep, 20k / 0.5 %: 5 cases 1-3 % better (man 1.153 -> 1.124), none
   // worse; 20k / 0.1 % unchanged.
   if (settings.noisy_height && height_n > 0) {
-    const double mean = residual_sum / double(height_n), floor = kResidualFloor * settings.h_final;
-    const double own = std::sqrt(std::max(0.0, mean * mean - floor * floor));
+    const double mean = residual_sum / double(height_n), residual_floor = kResidualFloor * settings.h_final;
+    const double own = std::sqrt(std::max(0.0, mean * mean - residual_floor * residual_floor));
     const double more = own * own - settings.noise * settings.noise, bound = kMaxNoiseShiftRedo * own;
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, raw_second.size(), 1 << 14),
                       [&](const tbb::blocked_range<std::size_t>& r) {
