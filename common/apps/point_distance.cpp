@@ -466,6 +466,57 @@ int height_points(const PointIndex& index, const Vec3d& x, const Vec3d& n, const
   return kept;
 }
 
+// A height fit with the variance of its offset (world^2).
+struct ScaledFit {
+  HeightFit fit;
+  double variance = 0.0;
+};
+
+ScaledFit with_variance(const HeightFit& f) {
+  const double se = f.residual * f.spread;
+  return {f, se * se};
+}
+
+// The estimate `large` shrunk toward `smaller` (a fit over the nearer part of the same points):
+// for nested least-squares fits Var(smaller - large) ~ v_small - v_large, so the large fit's
+// bias^2 reads D^2 - (v_small - v_large) with D the offsets' difference, and the weight of
+// `large` that minimises the blend's mean squared error is (v_small - v_large) / D^2 where
+// D^2 exceeds that variance, else 1. The quadrics are blended coefficient by coefficient.
+ScaledFit blend_scales(const ScaledFit& large, const ScaledFit& smaller) {
+  const HeightFit &a = large.fit, &b = smaller.fit;
+  const double dv = std::max(0.0, smaller.variance - large.variance), d = a.offset - b.offset;
+  const double w = d * d <= dv ? 1.0 : dv / (d * d);
+  ScaledFit out = large;
+  // Coefficient i is in units of inv_r^degree (c0: world; c1, c2: degree 1; c3..c5: degree 2):
+  // the smaller fit's, in the large one's units, are scaled by (inv_r_small / inv_r_large)^degree.
+  const double q = b.inv_r / a.inv_r;
+  const double scale[6] = {1.0, q, q, q * q, q * q, q * q};
+  for (std::size_t i = 0; i < 6; ++i) out.fit.c[i] = w * a.c[i] + (1.0 - w) * b.c[i] * scale[i];
+  out.fit.offset = w * a.offset + (1.0 - w) * b.offset;
+  out.fit.residual = w * a.residual + (1.0 - w) * b.residual;
+  // Var(w L + (1 - w) S) with Cov(L, S) ~ Var(L) for nested fits.
+  out.variance = w * w * large.variance + (1.0 - w) * (1.0 - w) * smaller.variance +
+                 2.0 * w * (1.0 - w) * large.variance;
+  return out;
+}
+
+// The soft three-scale choice (HeightNoise::soft): the fit over all `used` points blended
+// toward the fit over the nearer half, that toward the fit over the nearer quarter
+// (blend_scales), each scale at least kSmallPatch points. `large` is the fit over all of them
+// with its spread (returned where the smaller scales do not fit).
+HeightFit soft_scale_choice(const TangentPoint* pts, int used, double sigma, const HeightFit& large) {
+  const int half = std::max(kSmallPatch, used / 2), quarter = std::max(kSmallPatch, used / 4);
+  if (used < 2 * half) return large;
+  const HeightFit medium = quadric_height<true>(pts, half, sigma);
+  if (!medium.ok) return large;
+  ScaledFit out = blend_scales(with_variance(large), with_variance(medium));
+  if (half >= 2 * quarter) {
+    const HeightFit small = quadric_height<true>(pts, quarter, sigma);
+    if (small.ok) out = blend_scales(out, with_variance(small));
+  }
+  return out.fit;
+}
+
 SheetModel sheet_model_from(const PointIndex& index, const NearbyPoints* near, const Vec3d& x, const Vec3d& n, int k,
                             int k_height, double min_band, const HeightNoise& noise) {
   Sheet sh;
@@ -482,14 +533,17 @@ SheetModel sheet_model_from(const PointIndex& index, const NearbyPoints* near, c
   f.e2 = e2;
   std::array<TangentPoint, kMaxNeighbors> pts;  // the first `used` entries are written
   const int used = height_points(index, x, n, e1, e2, sh, k_height, noise, pts);
-  HeightFit fit = quadric_height<false>(pts.data(), used, noise.sigma);
+  HeightFit fit = noise.soft ? quadric_height<true>(pts.data(), used, noise.sigma)
+                             : quadric_height<false>(pts.data(), used, noise.sigma);
   if (!fit.ok) return f;
   // The patch's scale from the data (intersection of confidence intervals, Lepski): the
   // large patch averages the noise, but where the surface bends more than a quadric
   // describes over it (fine detail), its offset leaves the small patch's confidence
   // interval: then the small patch's (unbiased) offset is taken.
   const int small = std::max(kSmallPatch, used / kPatchRatio);
-  if (used >= 2 * small) {
+  if (noise.soft) {
+    fit = soft_scale_choice(pts.data(), used, noise.sigma, fit);
+  } else if (used >= 2 * small) {
     const HeightFit small_fit = quadric_height<true>(pts.data(), small, noise.sigma);
     if (small_fit.ok && std::abs(fit.offset - small_fit.offset) > kPatchConfidence * small_fit.residual * small_fit.spread)
       fit = small_fit;

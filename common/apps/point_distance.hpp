@@ -128,9 +128,12 @@ LocalFit one_sided_fit(const PointIndex& index, const Vec3d& x, const Vec3d& n, 
 // at 0.5 % noise, bench_reconstruct --sweep). The disc keeps at least half the band's points
 // (where the ball is barely wider than the slab, a smaller disc would leave the fit too few);
 // it costs a quarter of them under 0.5 % noise, which pays only where the noise is strong.
+// soft: the patch's scale by the soft three-scale choice instead of the two-scale rule (see
+// sheet_fit), for a k_height that is a multiple of what the two-scale rule would take.
 struct HeightNoise {
   double sigma = 0.0;   // world
   bool select = false;  // points chosen without a bias toward the tangent plane
+  bool soft = false;    // the patch's scale by the soft three-scale choice (sheet_fit)
 };
 
 // The one-sided fit of the first k points and a second-order fit of the first k_height
@@ -147,7 +150,13 @@ struct HeightNoise {
 // follows the data: with at least 32 kept points a second quadric over the nearest half is
 // fitted, and its offset taken where the two differ by more than 1.5 of its standard errors
 // (the large patch bent by detail the quadric cannot follow; intersection of confidence
-// intervals, Lepski). has_height is false (height_offset 0) with fewer than 10 kept points or
+// intervals, Lepski). With noise.soft, the fits over all, the nearest half and the nearest
+// quarter (each at least 16 points) are blended instead: each larger one shrunk toward the
+// next smaller by the weight that minimises the mean squared error given the bias^2 their
+// offsets' difference reveals beyond its noise (for nested fits Var(small - large) ~
+// v_small - v_large: weight min(1, (v_small - v_large) / D^2)); smooth patches keep the large
+// fit's averaging, detail falls back toward the small fits without a hard threshold's
+// undetected bias (tests/unit/test_sheet_fit_scales.cpp). has_height is false (height_offset 0) with fewer than 10 kept points or
 // an ill-conditioned system. Thread-safe.
 struct SheetFit {
   LocalFit plane;

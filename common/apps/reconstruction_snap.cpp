@@ -96,6 +96,15 @@ constexpr long kMaxSmoothing = 3;
 // 1.009 -> 0.977; 50k: 21 cases better, none worse. Below it the count stays (the law's
 // smaller patches: 50k / 0.1 %, 9 cases worse and 3 better, median 0.761 -> 0.783).
 constexpr int kNoisyHeightNeighbors = 48;
+// Up to kReferenceNoise the height fits take kSoftScaleGrowth times the count law's points and
+// blend the fits over all, the nearer half and the nearer quarter of them by their estimated
+// bias and variance (point_distance.hpp HeightNoise::soft).
+constexpr int kSoftScaleGrowth = 3;
+// ... where the height fits' residual reads at least this (final voxels): noise, not the
+// quadric's misfit on clean data (0.03-0.16 on bench_reconstruct --sweep's clean meshes, where
+// more points cost the featured ones 10-20 %: anchor, hand, elephant, turbine at 20k; 0.3-0.45
+// at 0.1 % noise).
+constexpr double kSoftScaleMinNoise = 0.25;
 constexpr double kReferenceDensity = 0.15;
 constexpr double kDensityExponent = 0.75;
 // The noise (final voxels) at which kNoisyHeightNeighbors was measured best (0.2% noise).
@@ -182,10 +191,10 @@ double front_density(const NarrowBand& band, std::size_t points, double h_final)
 // as sigma^(1/2) density^(3/4); kNoisyHeightNeighbors at kReferenceNoise. `noise` is the
 // height fits' residual (no sagitta), counted beyond kResidualFloor. Never below
 // kHeightNeighbors (clean data: 16 measured best; 24 cost the clean blobby 20 %).
-int height_neighbors_for(double density, double noise) {
+int height_neighbors_for(double density, double noise, int growth) {
   if (!(density > 0.0)) return kNoisyHeightNeighbors;
   const double excess = std::sqrt(std::max(0.0, noise * noise - kResidualFloor * kResidualFloor));
-  const double k = kNoisyHeightNeighbors * std::pow(density / kReferenceDensity, kDensityExponent) *
+  const double k = growth * kNoisyHeightNeighbors * std::pow(density / kReferenceDensity, kDensityExponent) *
                    std::sqrt(excess / kReferenceNoise);
   return int(std::clamp(std::lround(k), long(kHeightNeighbors), 256L));
 }
@@ -295,6 +304,7 @@ struct SnapSettings {
   int height_neighbors = kHeightNeighbors;  // height fits
   double height_guard = kHeightGuard;  // voxels: height fits within this of the plane fit's are used
   bool noisy_height = false;     // noisy data: the height fits' offsets as well (see kNoisyHeightNeighbors)
+  bool soft_scales = false;      // the height fits' soft three-scale patch choice (kSoftScaleGrowth)
   double noise = 0.0;            // world: the points' noise the previous pass measured, beyond kResidualFloor
   double window = kSnapWindow;   // voxels that move
   double fit_window = kFitWindow;  // voxels with their own fit (within the window)
@@ -314,7 +324,7 @@ SnapPass snap_to_fits(NarrowBand& band, const PointIndex& index, const SnapSetti
   const bool same_grid = coarse.voxel_size() == h;  // a single level: its own curvature
   const float unset = std::numeric_limits<float>::quiet_NaN();
   const FitSettings fit_settings{neighbors, settings.height_neighbors, kOneSidedBand * h, kShareRadius * h,
-                                 {settings.noise, settings.noisy_height}};
+                                 {settings.noise, settings.noisy_height, settings.soft_scales}};
   // 1. The front offset e = clamp(s - u, +-h) of every voxel within the window.
   std::vector<float> offset(band.active_voxel_count(), unset);
   std::vector<std::uint8_t> moves(band.active_voxel_count(), 0);  // within the window
@@ -525,15 +535,21 @@ SnapOutput snap_level(NarrowBand band, const PointIndex& index, const Reconstruc
   auto settings_for = [&](bool refine) {
     SnapSettings settings;
     settings.neighbors = o.neighbors;
+    // Noise between kSoftScaleMinNoise and the reference: the fits take kSoftScaleGrowth
+    // times the count law's points and choose the patch by the soft three-scale rule
+    // (sheet_fit's HeightNoise::soft).
+    settings.soft_scales = previous_height_noise >= kSoftScaleMinNoise && previous_height_noise <= kReferenceNoise;
+    const int growth = settings.soft_scales ? kSoftScaleGrowth : 1;
     settings.height_neighbors = std::max(o.neighbors, kHeightNeighbors);
     if (previous_noise >= kCleanNoise) {
       settings.noisy_height = true;
       settings.height_neighbors =
-          std::max(settings.height_neighbors, noisy_height_neighbors(band, index.size(), h_final, previous_height_noise));
+          std::max(settings.height_neighbors,
+                   std::min(256, growth * noisy_height_neighbors(band, index.size(), h_final, previous_height_noise)));
     } else if (previous_height_noise > 0.0) {  // clean so far: more points as the noise grows
       settings.height_neighbors = std::max(settings.height_neighbors,
                                            height_neighbors_for(front_density(band, index.size(), h_final),
-                                                                previous_height_noise));
+                                                                previous_height_noise, growth));
     }
     settings.height_guard = std::max(kHeightGuard, kHeightGuardNoise * previous_height_noise * h_final / h);
     settings.noise = std::sqrt(std::max(0.0, previous_height_noise * previous_height_noise -
