@@ -96,11 +96,12 @@ constexpr long kMaxSmoothing = 3;
 // 1.009 -> 0.977; 50k: 21 cases better, none worse. Below it the count stays (the law's
 // smaller patches: 50k / 0.1 %, 9 cases worse and 3 better, median 0.761 -> 0.783).
 constexpr int kNoisyHeightNeighbors = 48;
-// Up to kReferenceNoise the height fits take kSoftScaleGrowth times the count law's points and
-// blend the fits over all, the nearer half and the nearer quarter of them by their estimated
-// bias and variance (point_distance.hpp HeightNoise::soft).
+// Where the height fits' residual lies between kSoftScaleMinNoise and kReferenceNoise, the
+// fits take kSoftScaleGrowth times the count law's points and blend the fits over all, the
+// nearer half and the nearer quarter of them by their estimated bias and variance
+// (point_distance.hpp HeightNoise::soft; README round 13: 20k / 0.1 % median 0.887 -> 0.839).
 constexpr int kSoftScaleGrowth = 3;
-// ... where the height fits' residual reads at least this (final voxels): noise, not the
+// The lower bound (final voxels): there the residual is noise, not the
 // quadric's misfit on clean data (0.03-0.16 on bench_reconstruct --sweep's clean meshes, where
 // more points cost the featured ones 10-20 %: anchor, hand, elephant, turbine at 20k; 0.3-0.45
 // at 0.1 % noise).
@@ -190,7 +191,8 @@ double front_density(const NarrowBand& band, std::size_t points, double h_final)
 // against variance ~ sigma^2 / (density r^2) goes as sigma^(1/4) density^(-1/8), so the count
 // as sigma^(1/2) density^(3/4); kNoisyHeightNeighbors at kReferenceNoise. `noise` is the
 // height fits' residual (no sagitta), counted beyond kResidualFloor. Never below
-// kHeightNeighbors (clean data: 16 measured best; 24 cost the clean blobby 20 %).
+// kHeightNeighbors (clean data: 16 measured best; 24 cost the clean blobby 20 %). growth
+// multiplies the law's count before that floor (kSoftScaleGrowth under the soft scale choice).
 int height_neighbors_for(double density, double noise, int growth) {
   if (!(density > 0.0)) return kNoisyHeightNeighbors;
   const double excess = std::sqrt(std::max(0.0, noise * noise - kResidualFloor * kResidualFloor));
