@@ -56,7 +56,10 @@
 //   outside by simple flips only, so no handle is made, except a gap lined almost only by
 //   buried points, which reopens whole, tunnels included: pierce_tunnels, CGAL's anchor and
 //   couplingdown; then, narrow_gaps, a second carving at 0.7 of that clearance, simple flips
-//   only: camel, hand, man at 20k points; then at least 3 snap passes: homer's
+//   only: camel, hand, man at 20k points; under noise wider than half a final voxel, the
+//   clearance is measured from the points projected onto their neighbourhoods' planes,
+//   denoised_clearance, apps/point_denoise.hpp, and a point's burial depth beyond the band's
+//   inner edge is read through the band; then at least 3 snap passes: homer's
 //   legs at 50k points, bench_reconstruct --sweep); then snap_passes times: every voxel within 1 voxel of the front computes its front offset
 //   e = clamp(s - u, -h, h) from fits of the points near the voxel (the others within 1.5
 //   voxels, which also move, take their neighbours' mean e; the voxels of a column along the
@@ -153,6 +156,7 @@ struct ReconstructionOptions {
   bool carve_gaps = true;       // finer levels: reopen gaps the start shell closed over buried points
   bool pierce_tunnels = true;   // carve_gaps: a gap lined almost only by buried points may reopen as a tunnel
   bool narrow_gaps = true;      // carve_gaps: a second carving reopens gaps narrower than the sampling gap's clearance
+  bool denoised_clearance = true;  // carve_gaps under noise (sigma > 0.5 final voxels): clearance from points projected onto their planes
   int max_resolution = 4096;    // cap on the final grid's longest side (voxels)
   ProgressHook progress;
   std::function<void(const std::string&)> log;  // progress lines; empty: none

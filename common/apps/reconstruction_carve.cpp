@@ -8,6 +8,7 @@
 #include <iterator>
 #include <limits>
 #include <numeric>
+#include <optional>
 #include <vector>
 
 #include <tbb/blocked_range.h>
@@ -47,12 +48,62 @@ std::uint32_t find_root(std::vector<std::uint32_t>& parent, std::uint32_t i) {
   return i;
 }
 
-// The band's value (trilinear) at every point: how deep each lies inside the surface.
-std::vector<float> point_values(const NarrowBand& band, const PointIndex& index) {
+// Offsets within `radius` voxels, nearest first.
+std::vector<Coord> ball_by_distance(int radius) {
+  std::vector<Coord> ball;
+  for (int z = -radius; z <= radius; ++z)
+    for (int y = -radius; y <= radius; ++y)
+      for (int x = -radius; x <= radius; ++x)
+        if (x * x + y * y + z * z <= radius * radius) ball.push_back({x, y, z});
+  std::stable_sort(ball.begin(), ball.end(), [](const Coord& a, const Coord& b) {
+    return a.x * a.x + a.y * a.y + a.z * a.z < b.x * b.x + b.y * b.y + b.z * b.z;
+  });
+  return ball;
+}
+
+// How deep point p lies inside the surface when the band's value there is its limit (p beyond
+// the band's inner edge): the shortest way to the surface through the band, min over active
+// voxels v near p of |p - v| + max(0, -u(v)) (u(v) is v's distance to the surface; an upper
+// bound, within a small fraction of a voxel of the depth for a distance band), at most `cap`.
+// The ball is searched nearest first and left once no farther voxel can improve the minimum.
+double depth_beyond_band(BandAccessor& acc, const NarrowBand& band, const Vec3d& p, const std::vector<Coord>& ball,
+                         double cap) {
+  const double h = band.voxel_size();
+  const Vec3d q = (p - band.origin()) / h;
+  const Coord c{int(std::lround(q.x)), int(std::lround(q.y)), int(std::lround(q.z))};
+  const Vec3d off = q - Vec3d{double(c.x), double(c.y), double(c.z)};  // |off| <= sqrt(3) / 2
+  double best = cap / h;
+  for (const Coord& d : ball) {
+    const Vec3d dv{double(d.x), double(d.y), double(d.z)};
+    if (length(dv) - 0.8660254 >= best) break;
+    const std::optional<float> u = acc.probe(c + d);
+    if (!u) continue;
+    best = std::min(best, length(dv - off) + std::max(0.0, -double(*u) / h));
+  }
+  return best * h;
+}
+
+// The band's value (trilinear) at every point: how deep each lies inside the surface (negative
+// inside). The band's values stop at -background(), so where a depth threshold the caller
+// tests (`deepest`, world) lies near or beyond that, the points at the band's inner edge
+// get their depth through the band (depth_beyond_band) instead, up to deepest + h: with a
+// noise sigma of 0.75 voxels or more the burial depth (4 sigma) exceeds a 3-voxel band, and
+// no point could ever read as buried.
+std::vector<float> point_values(const NarrowBand& band, const PointIndex& index, double deepest) {
+  const double h = band.voxel_size();
+  const double limit = double(band.background()) - h;  // values beyond may be the band's limit
+  const bool refine = deepest > limit;
+  const double cap = deepest + h;
+  const std::vector<Coord> ball = refine ? ball_by_distance(int(std::ceil(cap / h)) + 1) : std::vector<Coord>{};
   std::vector<float> value(index.size());
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, index.size(), 4096), [&](const tbb::blocked_range<std::size_t>& r) {
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, index.size(), 1024), [&](const tbb::blocked_range<std::size_t>& r) {
     BandAccessor acc(band);
-    for (std::size_t i = r.begin(); i != r.end(); ++i) value[i] = sample_trilinear(acc, band, index.points()[i]);
+    for (std::size_t i = r.begin(); i != r.end(); ++i) {
+      const Vec3d& p = index.points()[i];
+      value[i] = sample_trilinear(acc, band, p);
+      if (refine && double(value[i]) < -limit)
+        value[i] = -float(std::max(-double(value[i]), depth_beyond_band(acc, band, p, ball, cap)));
+    }
   });
   return value;
 }
@@ -128,34 +179,21 @@ NarrowBand with_active(const NarrowBand& band, const std::vector<std::uint64_t>&
 }
 
 // Empty space farther than this from every point may be carved.
-double clearance_of(const CarveSettings& s, double h) { return std::max({h, kCarveNoiseDepth * s.noise, s.gap}); }
+// The noise the clearance allows for is that of the points it is measured from.
+double clearance_of(const CarveSettings& s, double h) {
+  const double noise = s.clearance_points ? s.clearance_noise : s.noise;
+  return std::max({h, kCarveNoiseDepth * noise, s.gap});
+}
 
-// One carving (see reconstruction_parts.hpp) with the given settings; its candidates lie no
-// farther than `outer` from every point (the narrow carving leaves the space beyond the first
-// one's clearance, which that carving has judged, alone).
-CarveOutput carve_once(NarrowBand band, const PointIndex& index, const CarveSettings& s, double outer,
-                       const ProgressHook& progress) {
-  CarveOutput out;
+// 1. Candidate voxels: within `reach` voxels of a buried point, inside the surface, farther
+// than `clearance` (and no farther than `outer`) from every point of `clearance_points` (the
+// empty space beside the buried walls, and the parts' own interiors beyond their walls: told
+// apart by carve_regions). Sorted keys. In chunks of buried points, each chunk's keys
+// deduplicated and merged: the transient memory is a chunk's balls, not every buried point's.
+std::vector<std::uint64_t> air_candidates(const NarrowBand& band, const PointIndex& index,
+                                          const PointIndex& clearance_points, const std::vector<std::uint32_t>& buried,
+                                          int reach, double clearance, double outer, const ProgressHook& progress) {
   const double h = band.voxel_size();
-  const double depth = std::max(kCarveDepthVoxels * h, kCarveNoiseDepth * s.noise);
-  const double clearance = clearance_of(s, h);
-  const std::vector<float> value = point_values(band, index);
-  const std::vector<std::uint32_t> buried = deeper_than(value, depth);
-  out.buried = buried.size();
-  auto unchanged = [&] {
-    out.band = std::move(band);
-    return std::move(out);
-  };
-  if (buried.size() < std::max<std::size_t>(kMinBuried, std::size_t(kMinBuriedShare * double(index.size()))) ||
-      double(buried.size()) > kMaxBuriedShare * double(index.size()))
-    return unchanged();
-  progress.check("reconstruct carve");
-  // 1. Candidate voxels: within `reach` of a buried point, inside the surface, farther than
-  // `clearance` from every point (the empty space beside the buried walls, and the parts'
-  // own interiors beyond their walls: told apart below).
-  const int reach = int(std::ceil(s.reach_voxels));
-  // In chunks of buried points, each chunk's keys deduplicated and merged: the transient
-  // memory is a chunk's balls, not every buried point's.
   std::vector<std::uint64_t> keys;
   for (std::size_t first = 0; first < buried.size(); first += kCarveChunk) {
     progress.check("reconstruct carve");
@@ -189,46 +227,66 @@ CarveOutput carve_once(NarrowBand band, const PointIndex& index, const CarveSett
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, keys.size(), 1024), [&](const tbb::blocked_range<std::size_t>& r) {
     progress.check("reconstruct carve");
     for (std::size_t i = r.begin(); i != r.end(); ++i) {
-      const double d = index.nearest(band.world(coord_of(keys[i]))).distance;
+      const double d = clearance_points.nearest(band.world(coord_of(keys[i]))).distance;
       clear[i] = d > clearance && d <= outer;
     }
   });
   std::vector<std::uint64_t> air;
   for (std::size_t i = 0; i < keys.size(); ++i)
     if (clear[i]) air.push_back(keys[i]);
-  std::vector<std::uint64_t>().swap(keys);
-  if (air.empty()) return unchanged();
-  // 2. Regions: 6-connected components of the candidates.
+  return air;
+}
+
+// The 6-connected components of the voxels `air` (sorted keys): each one's root index.
+std::vector<std::uint32_t> label_regions(const std::vector<std::uint64_t>& air) {
   auto find = [&](const Coord& c) -> std::int64_t {
     const auto it = std::lower_bound(air.begin(), air.end(), key_of(c));
     return it != air.end() && *it == key_of(c) ? std::int64_t(it - air.begin()) : -1;
   };
-  const Coord steps[6] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
+  const Coord plus[3] = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}};  // each neighbour pair once
   std::vector<std::uint32_t> parent(air.size());
   std::iota(parent.begin(), parent.end(), 0u);
   for (std::size_t i = 0; i < air.size(); ++i) {
     const Coord c = coord_of(air[i]);
-    for (int k = 0; k < 6; k += 2) {  // + directions: each pair once
-      const std::int64_t j = find(c + steps[k]);
+    for (const Coord& step : plus) {
+      const std::int64_t j = find(c + step);
       if (j < 0) continue;
       const std::uint32_t a = find_root(parent, std::uint32_t(i)), b = find_root(parent, std::uint32_t(j));
       if (a != b) parent[std::max(a, b)] = std::min(a, b);
     }
   }
-  // 3. A region is a closed gap when it meets the outside (the shell spans the gap's mouth)
-  // and the points lining it are mostly buried (a gap's walls); a part's own interior meets
-  // the outside only through a hole in the sampling, and its lining is the part's surface,
-  // mostly on the front.
   std::vector<std::uint32_t> root(air.size());
   for (std::size_t i = 0; i < air.size(); ++i) root[i] = find_root(parent, std::uint32_t(i));
-  std::vector<std::uint8_t> meets_outside(air.size(), 0);
+  return root;
+}
+
+// Steps 2-4: which candidates are carved (sorted keys) and which of them pierced, with the
+// counts of regions.
+struct RegionChoice {
+  std::vector<std::uint64_t> carved, pierced;
+  int regions = 0, pierced_regions = 0;
+};
+RegionChoice carve_regions(const NarrowBand& band, const PointIndex& index, const std::vector<std::uint64_t>& air,
+                           const std::vector<float>& value, double lining_depth, double clearance, bool allow_pierce) {
+  const double h = band.voxel_size();
+  RegionChoice out;
+  // 2. Regions: 6-connected components of the candidates.
+  const std::vector<std::uint32_t> root = label_regions(air);
+  auto find = [&](const Coord& c) { return std::binary_search(air.begin(), air.end(), key_of(c)); };
+  const Coord steps[6] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
+  // 3. A region is a closed gap when it meets the outside through a mouth (the shell spans
+  // it: at least kMinMouthShare size^(2/3) faces, the gap's width across) and the points
+  // lining it are mostly buried (a gap's walls); a part's own interior meets the outside only
+  // through a hole in the sampling or a dent of the front, a face or a few, and its lining is
+  // the part's surface, mostly on the front.
+  std::vector<std::uint32_t> mouth(air.size(), 0);  // faces between the region and the outside
   std::vector<std::uint32_t> size(air.size(), 0);
   std::vector<std::uint32_t> lining(air.size(), 0), lining_buried(air.size(), 0);
   std::vector<std::uint8_t> is_buried(index.size(), 0);
   // The lining counts the points below the front (deeper than max(1.5 h, 2 noise), not the
   // burial depth): under noise the walls of a closed gap near its mouth lie shallower than
   // 4 noise, and counting them as front points rejected the gap (CGAL's anchor at 0.5 %).
-  for (const std::uint32_t p : deeper_than(value, std::max(kCarveDepthVoxels * h, kLiningNoiseDepth * s.noise)))
+  for (const std::uint32_t p : deeper_than(value, lining_depth))
     is_buried[p] = 1;
   std::vector<std::uint32_t> seen_by(index.size(), std::uint32_t(-1));
   std::vector<std::pair<std::uint32_t, double>> near;
@@ -240,9 +298,9 @@ CarveOutput carve_once(NarrowBand band, const PointIndex& index, const CarveSett
     bool boundary = false;
     for (const Coord& step : steps) {
       const Coord q = c + step;
-      if (find(q) >= 0) continue;
+      if (find(q)) continue;
       boundary = true;
-      if (!acc.is_inside(q)) meets_outside[r] = 1;
+      if (!acc.is_inside(q)) ++mouth[r];
     }
     if (!boundary) continue;
     index.within(band.world(c), clearance + 1.5 * h, near);
@@ -259,23 +317,37 @@ CarveOutput carve_once(NarrowBand band, const PointIndex& index, const CarveSett
   for (std::size_t i = 0; i < air.size(); ++i) {
     const std::uint32_t r = root[i];
     if (r != i) continue;
-    if (meets_outside[r] && size[r] >= kMinCarveVoxels &&
+    const bool has_mouth = double(mouth[r]) >= kMinMouthShare * std::cbrt(double(size[r]) * double(size[r]));
+    if (has_mouth && size[r] >= kMinCarveVoxels &&
         double(lining_buried[r]) >= kMinBuriedLining * double(lining[r])) {
       carve[r] = 1;
       ++out.regions;
-      if (s.pierce && size[r] >= kMinPierceVoxels && double(lining_buried[r]) >= kMinPierceLining * double(lining[r])) {
+      if (allow_pierce && size[r] >= kMinPierceVoxels && double(lining_buried[r]) >= kMinPierceLining * double(lining[r])) {
         pierce[r] = 1;
         ++out.pierced_regions;
       }
     }
   }
-  std::vector<std::uint64_t> carved, pierced;
   for (std::size_t i = 0; i < air.size(); ++i) {
-    if (carve[root[i]]) carved.push_back(air[i]);
-    if (pierce[root[i]]) pierced.push_back(air[i]);
+    if (carve[root[i]]) out.carved.push_back(air[i]);
+    if (pierce[root[i]]) out.pierced.push_back(air[i]);
   }
-  if (carved.empty()) return unchanged();
-  // 5. The carved voxels and their inside face neighbours join the band (-h/2 where they were
+  return out;
+}
+
+// 5. The band with the chosen regions dug out (see below), how many voxels turned outside and
+// the bricks touched.
+struct Dug {
+  NarrowBand band;
+  std::uint64_t carved_voxels = 0;
+  std::vector<std::uint64_t> bricks;  // sorted brick keys
+};
+Dug dig_regions(const NarrowBand& band, const RegionChoice& choice, const ProgressHook& progress) {
+  Dug out;
+  const double h = band.voxel_size();
+  const std::vector<std::uint64_t>& carved = choice.carved;
+  const std::vector<std::uint64_t>& pierced = choice.pierced;
+  // The carved voxels and their inside face neighbours join the band (-h/2 where they were
   // inactive: every sign change stays between active voxels, the band's invariant); the
   // carved ones turn outside (+h/2) as far as the topology guard lets them: simple flips
   // only, taken again as their neighbours flip, so the region is dug out from the shell
@@ -309,7 +381,6 @@ CarveOutput carve_once(NarrowBand band, const PointIndex& index, const CarveSett
   TopologyGuardResult kept = guard_topology(active, active, std::move(proposed), guard);
   out.carved_voxels = carved.size() - std::min<std::uint64_t>(carved.size(), kept.refused_flips);
   active.swap_values(kept.values);
-  out.band = std::move(active);
   for (const std::uint64_t k : carved) {
     const Coord b = brick_of(coord_of(k));
     for (int dz = -1; dz <= 1; ++dz)
@@ -321,7 +392,40 @@ CarveOutput carve_once(NarrowBand band, const PointIndex& index, const CarveSett
   RedistanceOptions redo;
   redo.half_width = band.half_width();
   redo.progress = progress;
-  out.band = redistance(reframed(out.band, {}, 1.0), redo).band;
+  out.band = redistance(reframed(active, {}, 1.0), redo).band;
+  return out;
+}
+
+// One carving (see reconstruction_parts.hpp) with the given settings; its candidates lie no
+// farther than `outer` from every point (the narrow carving leaves the space beyond the first
+// one's clearance, which that carving has judged, alone).
+CarveOutput carve_once(NarrowBand band, const PointIndex& index, const CarveSettings& s, double outer,
+                       const ProgressHook& progress) {
+  CarveOutput out;
+  const double h = band.voxel_size();
+  const double depth = std::max(kCarveDepthVoxels * h, kCarveNoiseDepth * s.noise);
+  const double clearance = clearance_of(s, h);
+  const double lining_depth = std::max(kCarveDepthVoxels * h, kLiningNoiseDepth * s.noise);
+  const std::vector<float> value = point_values(band, index, std::max(depth, lining_depth));
+  const std::vector<std::uint32_t> buried = deeper_than(value, depth);
+  out.buried = buried.size();
+  out.band = std::move(band);
+  if (buried.size() < std::max<std::size_t>(kMinBuried, std::size_t(kMinBuriedShare * double(index.size()))) ||
+      double(buried.size()) > kMaxBuriedShare * double(index.size()))
+    return out;
+  progress.check("reconstruct carve");
+  const std::vector<std::uint64_t> air =
+      air_candidates(out.band, index, s.clearance_points ? *s.clearance_points : index, buried,
+                     int(std::ceil(s.reach_voxels)), clearance, outer, progress);
+  if (air.empty()) return out;
+  const RegionChoice choice = carve_regions(out.band, index, air, value, lining_depth, clearance, s.pierce);
+  out.regions = choice.regions;
+  out.pierced_regions = choice.pierced_regions;
+  if (choice.carved.empty()) return out;
+  Dug dug = dig_regions(out.band, choice, progress);
+  out.band = std::move(dug.band);
+  out.carved_voxels = dug.carved_voxels;
+  out.bricks = std::move(dug.bricks);
   return out;
 }
 
