@@ -19,9 +19,12 @@
 #include "geometry/analytic_shapes.hpp"
 #include "io/mesh_reader.hpp"
 #include "noisy_torus.hpp"
+#include "truth_distance.hpp"
 
 namespace levelset::apps {
 namespace {
+
+using test::mean_distance_from;
 
 // n points uniformly on the unit square in z = 0, with Gaussian noise sigma along z.
 std::vector<Vec3d> noisy_plane(std::size_t n, double sigma, unsigned seed) {
@@ -252,19 +255,6 @@ CgalCase cgal_case(const char* name, std::size_t count = 50000) {
   s.seed = 1;
   c.points = sample_mesh_surface(c.truth, s);
   return c;
-}
-
-// The mean distance from 50k samples of the true surface to `mesh` (large where a gap or hole
-// of the truth is filled).
-double mean_distance_from(const TriangleMesh& truth, const TriangleMesh& mesh) {
-  SurfaceSampleOptions ts;
-  ts.count = 50000;
-  ts.seed = 7;
-  const MeshDistance d(mesh);
-  double sum = 0.0;
-  const std::vector<Vec3d> samples = sample_mesh_surface(truth, ts);
-  for (const Vec3d& p : samples) sum += d.distance(p);
-  return sum / double(samples.size());
 }
 
 // The reconstruction at resolution 256 with the defaults (`on`) and with one step switched off

@@ -16,9 +16,12 @@
 #include "apps/sample_points.hpp"
 #include "core/error.hpp"
 #include "io/mesh_reader.hpp"
+#include "truth_distance.hpp"
 
 namespace levelset::apps {
 namespace {
+
+using test::mean_distance_from;
 
 // Points uniformly on the unit square at height z, Gaussian noise sigma along z.
 std::vector<Vec3d> noisy_square(std::size_t n, double z, double sigma, unsigned seed) {
@@ -114,17 +117,6 @@ const Couplingdown& couplingdown() {
     return d;
   }();
   return c;
-}
-
-double mean_distance_from(const TriangleMesh& truth, const TriangleMesh& mesh) {
-  SurfaceSampleOptions ts;
-  ts.count = 50000;
-  ts.seed = 7;
-  const MeshDistance d(mesh);
-  double sum = 0.0;
-  const std::vector<Vec3d> samples = sample_mesh_surface(truth, ts);
-  for (const Vec3d& p : samples) sum += d.distance(p);
-  return sum / double(samples.size());
 }
 
 ReconstructionResult reconstruct_at_256(bool denoised) {
