@@ -58,9 +58,11 @@ LevelOutput flow_level(NarrowBand band, const PointIndex& index, const Reconstru
 
 // ---- reconstruction_carve.cpp
 // Points deeper than max(kCarveDepthVoxels h, kCarveNoiseDepth noise) inside the front are
-// buried (a gap or tunnel the start shell closed: the points sampling its walls). The voxels
-// inside the front within reach_voxels of a buried point and farther than
-// clearance = max(h, kCarveNoiseDepth noise, gap) from every point form 6-connected regions;
+// buried (a gap or tunnel the start shell closed: the points sampling its walls; a point
+// beyond the band's inner edge reads its depth through the band, as the band's values stop at
+// its half-width). The voxels inside the front within reach_voxels of a buried point and
+// farther than clearance = max(h, kCarveNoiseDepth noise, gap) from every point (of
+// settings.clearance_points, with their noise, where given) form 6-connected regions;
 // a region that meets the outside through a mouth (the shell spans it: at least
 // kMinMouthShare size^(2/3) faces, not a pinhole) and whose lining (points
 // within clearance + 1.5 h of its boundary) is at least kMinBuriedLining below the front
