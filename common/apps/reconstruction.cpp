@@ -223,6 +223,7 @@ ReconstructionResult reconstruct_surface(const std::vector<Vec3d>& input, const 
     project.max_move = kDenoiseMaxMove * result.sampling.noise;
     projected = std::make_unique<PointIndex>(project_to_planes(*index, project).points);
     projected_noise = estimate_sampling(*projected, {16, 2000, o.progress}).noise;
+    result.denoised_noise = projected_noise;
     char line[256];
     std::snprintf(line, sizeof line, "carving clearance from the points projected onto their planes: noise %.3g -> %.3g (%.2f -> %.2f final voxels)",
                   result.sampling.noise, projected_noise, result.sampling.noise / h_final, projected_noise / h_final);

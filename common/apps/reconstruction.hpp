@@ -200,6 +200,8 @@ struct ReconstructionResult {
   double voxel_size = 0.0;      // final
   int resolution = 0;           // the final grid's (given, or chosen from the data); 0 with voxel_size
   SamplingEstimate sampling;    // the points' spacing and noise (world), measured first
+  double denoised_noise = 0.0;  // the noise of the points the carving's clearance was measured from
+                                // (denoised_clearance: projected onto their planes; 0: the raw points)
   std::uint64_t isolated_points = 0;  // isolated points outside the box the grids span (apps/point_extent.hpp)
   std::uint64_t duplicate_points = 0;  // copies merged before anything else (apps/unique_points.hpp)
   double coverage = 1.0;        // share of the points within max(2 h, 3 noise) of the surface (apps/surface_coverage.hpp)

@@ -102,7 +102,8 @@ void run_reconstruct_job(JobContext& ctx) {
                                 {"steps", result.steps},       {"seconds", result.seconds},
                                 {"resolution", result.resolution},
                                 {"resolution_from_data", o.resolution == 0 && o.voxel_size <= 0.0},
-                                {"sampling", {{"spacing", result.sampling.spacing}, {"noise", result.sampling.noise}}},
+                                {"sampling", {{"spacing", result.sampling.spacing}, {"noise", result.sampling.noise},
+                                              {"denoised_noise", result.denoised_noise}}},
                                 {"isolated_points", result.isolated_points}, {"duplicate_points", result.duplicate_points},
                                 {"coverage", result.coverage},
                                 {"levels", stages_json(result.stages)}};

@@ -83,7 +83,7 @@ int run(const ReconstructArgs& a) {
   stats.extra["voxel_size"] = r.voxel_size;
   stats.extra["resolution"] = r.resolution;
   stats.extra["resolution_from_data"] = a.resolution == 0 && a.voxel_size <= 0.0;
-  stats.extra["sampling"] = {{"spacing", r.sampling.spacing}, {"noise", r.sampling.noise}};
+  stats.extra["sampling"] = {{"spacing", r.sampling.spacing}, {"noise", r.sampling.noise}, {"denoised_noise", r.denoised_noise}};
   stats.extra["isolated_points"] = r.isolated_points;
   stats.extra["duplicate_points"] = r.duplicate_points;
   stats.extra["coverage"] = r.coverage;

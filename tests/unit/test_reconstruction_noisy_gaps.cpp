@@ -151,6 +151,9 @@ TEST(Reconstruction, ReopensHolesUnderNoiseWithTheDenoisedClearance) {
   // does, and the holes' walls come back (mean distance of the truth to ours: 4.4e-3 ->
   // 2.8e-3 measured).
   const ReconstructionResult raw = reconstruct_at_256(false), denoised = reconstruct_at_256(true);
+  EXPECT_EQ(raw.denoised_noise, 0.0);  // not used
+  EXPECT_GT(denoised.denoised_noise, 0.0);
+  EXPECT_LT(denoised.denoised_noise, 0.5 * denoised.sampling.noise);
   EXPECT_LT(mean_distance_from(couplingdown().truth, denoised.mesh),
             0.9 * mean_distance_from(couplingdown().truth, raw.mesh));
 }
