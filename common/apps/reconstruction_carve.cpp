@@ -48,6 +48,9 @@ std::uint32_t find_root(std::vector<std::uint32_t>& parent, std::uint32_t i) {
   return i;
 }
 
+// How far (voxels) point_values searches the band for a depth beyond it.
+constexpr double kMaxDepthSearchVoxels = 24.0;
+
 // Offsets within `radius` voxels, nearest first.
 std::vector<Coord> ball_by_distance(int radius) {
   std::vector<Coord> ball;
@@ -93,7 +96,9 @@ std::vector<float> point_values(const NarrowBand& band, const PointIndex& index,
   const double h = band.voxel_size();
   const double limit = double(band.background()) - h;  // values beyond may be the band's limit
   const bool refine = deepest > limit;
-  const double cap = deepest + h;
+  // The search ball is bounded (kMaxDepthSearchVoxels: ~60k offsets), whatever the noise says:
+  // deeper thresholds then read no point as buried, as before.
+  const double cap = std::min(deepest + h, kMaxDepthSearchVoxels * h);
   const std::vector<Coord> ball = refine ? ball_by_distance(int(std::ceil(cap / h)) + 1) : std::vector<Coord>{};
   std::vector<float> value(index.size());
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, index.size(), 1024), [&](const tbb::blocked_range<std::size_t>& r) {
