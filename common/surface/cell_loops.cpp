@@ -119,7 +119,8 @@ LoopSet trace(int m, int decisions) {
   return s;
 }
 
-// Faces of inside mask m with 4 crossings (the only ones whose decision bit matters).
+}  // namespace
+
 int ambiguous_faces(int m) {
   int faces = 0;
   for (int f = 0; f < 6; ++f) {
@@ -130,6 +131,8 @@ int ambiguous_faces(int m) {
   return faces;
 }
 
+namespace {
+
 // Built on first use: traced once per distinct decision pattern (the decisions on faces that
 // are not ambiguous do not matter), about 1/10 of the 16384 (mask, decisions) pairs, which
 // index the distinct sets (32 KiB of indices and ~60 KiB of sets instead of 640 KiB of copies:
@@ -138,9 +141,12 @@ int ambiguous_faces(int m) {
 struct Table {
   std::vector<LoopSet> sets;
   std::array<std::uint16_t, 256 * 64> index{};
+  std::array<std::uint8_t, 256> ambiguous{};
+  LoopLookup lookup;
   Table() {
     for (int m = 0; m < 256; ++m) {
       const int amb = ambiguous_faces(m);
+      ambiguous[std::size_t(m)] = std::uint8_t(amb);
       for (int d = 0; d < 64; ++d)
         if ((d & amb) == d) {
           index[std::size_t(m * 64 + d)] = std::uint16_t(sets.size());
@@ -149,8 +155,14 @@ struct Table {
       for (int d = 0; d < 64; ++d)
         if ((d & amb) != d) index[std::size_t(m * 64 + d)] = index[std::size_t(m * 64 + (d & amb))];
     }
+    lookup = LoopLookup{sets.data(), index.data(), ambiguous.data()};
   }
 };
+
+const Table& table() {
+  static const Table t;
+  return t;
+}
 
 }  // namespace
 
@@ -164,9 +176,8 @@ int unambiguous_triangles(int inside_mask) {
   return table[std::size_t(inside_mask)];
 }
 
-const LoopSet& loops_for(int inside_mask, int face_decisions) {
-  static const Table table;
-  return table.sets[table.index[std::size_t(inside_mask) * 64 + std::size_t(face_decisions)]];
-}
+const LoopSet& loops_for(int inside_mask, int face_decisions) { return table().lookup.at(inside_mask, face_decisions); }
+
+const LoopLookup& loop_lookup() { return table().lookup; }
 
 }  // namespace levelset::cell

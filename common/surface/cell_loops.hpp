@@ -59,6 +59,21 @@ int edge_from_lower_neighbor(int e, int a);
 // when it has 4 crossings, the inside corners are connected across the face).
 const LoopSet& loops_for(int inside_mask, int face_decisions);
 
+// Faces of inside mask m with 4 crossings (bit f), whose decision bits select its loops.
+int ambiguous_faces(int inside_mask);
+
+// The lookup behind loops_for for a hot loop: fetched once, then a table read per cell (no
+// first-use guard, no call). ambiguous[m] is ambiguous_faces(m).
+struct LoopLookup {
+  const LoopSet* sets = nullptr;
+  const std::uint16_t* index = nullptr;  // 64 entries per mask
+  const std::uint8_t* ambiguous = nullptr;
+  const LoopSet& at(int inside_mask, int face_decisions) const {
+    return sets[index[std::size_t(inside_mask) * 64 + std::size_t(face_decisions)]];
+  }
+};
+const LoopLookup& loop_lookup();
+
 // The fan_triangles of loops_for(m, 0) when m has no face with 4 crossings (then its loops do
 // not depend on the face decisions, and it has no centre vertex); -1 when it has one.
 int unambiguous_triangles(int inside_mask);
@@ -76,6 +91,21 @@ inline bool inside_connected(double a0, double a1, double a2, double a3) {
   return den > 0.0 ? num < 0.0 : num > 0.0;  // saddle value num/den < 0 (inside)
 }
 
+// The corners of face f in the order the decider reads them (around the face).
+inline constexpr int kDeciderCorners[6][4] = {{0, 2, 6, 4}, {1, 3, 7, 5}, {0, 1, 5, 4},
+                                               {2, 3, 7, 6}, {0, 1, 3, 2}, {4, 5, 7, 6}};
+
+// The face decision bits of a cell for its ambiguous faces (bits of ambiguous_faces(mask)),
+// from its 8 corner values minus iso.
+inline int face_decisions(const double a[8], int ambiguous) {
+  int d = 0;
+  for (int f = 0; f < 6; ++f) {
+    const int* c = kDeciderCorners[f];
+    if (((ambiguous >> f) & 1) && inside_connected(a[c[0]], a[c[1]], a[c[2]], a[c[3]])) d |= 1 << f;
+  }
+  return d;
+}
+
 // Inside mask and face decision bits of a cell from its 8 corner values minus iso.
 inline void classify(const double a[8], int& inside_mask, int& face_decisions) {
   int m = 0;
@@ -83,10 +113,8 @@ inline void classify(const double a[8], int& inside_mask, int& face_decisions) {
   inside_mask = m;
   int d = 0;
   if (m != 0 && m != 255) {
-    static constexpr int fc[6][4] = {{0, 2, 6, 4}, {1, 3, 7, 5}, {0, 1, 5, 4},
-                                     {2, 3, 7, 6}, {0, 1, 3, 2}, {4, 5, 7, 6}};
     for (int f = 0; f < 6; ++f) {
-      const int* c = fc[f];
+      const int* c = kDeciderCorners[f];
       const int s0 = (m >> c[0]) & 1, s1 = (m >> c[1]) & 1, s2 = (m >> c[2]) & 1,
                 s3 = (m >> c[3]) & 1;
       if (s0 == s2 && s1 == s3 && s0 != s1 && inside_connected(a[c[0]], a[c[1]], a[c[2]], a[c[3]]))

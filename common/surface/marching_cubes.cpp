@@ -62,22 +62,49 @@ void for_each_owned_edge(const ValidCells& valid, F&& f) {
       }
 }
 
-// The contoured cells of [0, 8)^3 that cross iso, in cell order: f(x, y, z, loops).
-template <typename F>
-void for_each_mixed_cell(const CellTile& t, const ValidCells& valid, double iso, F&& f) {
+// The contoured cells of [0, 8)^3 that cross iso, in cell order: f(x, y, z, loops). The
+// inside mask comes from the row bits; corners(x, y, z, a) fills a[8] with the values minus
+// iso, called only for a cell with an ambiguous face (its loops depend on the face decisions).
+template <typename Corners, typename F>
+void for_each_mixed_cell(const ValidCells& valid, Corners&& corners, F&& f) {
+  const cell::LoopLookup& loops = cell::loop_lookup();
   for (int z = 0; z < kBrickDim; ++z)
-    for (int y = 0; y < kBrickDim; ++y)
+    for (int y = 0; y < kBrickDim; ++y) {
+      const std::uint32_t rows[4] = {valid.inside_rows[std::size_t(ValidCells::row(y, z))],
+                                     valid.inside_rows[std::size_t(ValidCells::row(y + 1, z))],
+                                     valid.inside_rows[std::size_t(ValidCells::row(y, z + 1))],
+                                     valid.inside_rows[std::size_t(ValidCells::row(y + 1, z + 1))]};
       for (std::uint32_t bits = (valid.mixed_row(y, z) >> ValidCells::kH) & 0xffu; bits != 0; bits &= bits - 1) {
         const int x = std::countr_zero(bits);
-        double a[8];
-        const int p0 = CellTile::index(x, y, z);
-        for (int i = 0; i < 8; ++i) a[i] = double(t.values[p0 + kCornerOffset[i]]) - iso;
-        int m, d;
-        cell::classify(a, m, d);
-        if (m == 0 || m == 255) continue;
-        f(x, y, z, cell::loops_for(m, d));
+        int m = 0;
+        for (int i = 0; i < 8; ++i) m |= int((rows[i >> 1] >> (x + (i & 1) + ValidCells::kH)) & 1u) << i;
+        int d = 0;
+        if (const int ambiguous = loops.ambiguous[m]; ambiguous != 0) {
+          double a[8];
+          corners(x, y, z, a);
+          d = cell::face_decisions(a, ambiguous);
+        }
+        f(x, y, z, loops.at(m, d));
       }
+    }
 }
+
+// Per cell edge e: its lower corner's offset and its slot (tile index offset * 3 + axis) in
+// the per-edge arrays (EdgeCrossings::s, Scratch::vertex_of_edge), relative to the cell's p0.
+struct CellEdge {
+  std::int8_t dx, dy, dz, axis;
+  int slot;
+};
+constexpr std::array<CellEdge, 12> make_cell_edges() {
+  std::array<CellEdge, 12> out{};
+  for (int e = 0; e < 12; ++e) {
+    const int c = cell::edge_lower_corner(e);
+    out[std::size_t(e)] = {std::int8_t(c & 1), std::int8_t((c >> 1) & 1), std::int8_t((c >> 2) & 1),
+                           std::int8_t(e >> 2), 3 * kCornerOffset[c] + (e >> 2)};
+  }
+  return out;
+}
+constexpr std::array<CellEdge, 12> kCellEdges = make_cell_edges();
 
 // Pass 1 from the masks alone: the owned edges and, per contoured cell, its loop set's
 // counts (values are read only for a cell with an ambiguous face, whose loops depend on them).
@@ -94,31 +121,17 @@ void count_brick(const NarrowBand& band, const DecodedBand& decoded, std::uint32
       c.edge_vertices += std::uint32_t(std::popcount(bits));
     }
   c.owned.finish();
-  for (int z = 0; z < kBrickDim; ++z)
-    for (int y = 0; y < kBrickDim; ++y) {
-      const std::uint32_t rows[4] = {valid.inside_rows[std::size_t(ValidCells::row(y, z))],
-                                     valid.inside_rows[std::size_t(ValidCells::row(y + 1, z))],
-                                     valid.inside_rows[std::size_t(ValidCells::row(y, z + 1))],
-                                     valid.inside_rows[std::size_t(ValidCells::row(y + 1, z + 1))]};
-      for (std::uint32_t bits = (valid.mixed_row(y, z) >> ValidCells::kH) & 0xffu; bits != 0; bits &= bits - 1) {
-        const int x = std::countr_zero(bits);
-        int m = 0;
-        for (int i = 0; i < 8; ++i) m |= int((rows[i >> 1] >> (x + (i & 1) + ValidCells::kH)) & 1u) << i;
-        ++c.cells;
-        if (const int plain = cell::unambiguous_triangles(m); plain >= 0) {
-          c.triangles += std::uint32_t(plain);
-          continue;
-        }
-        double a[8];
+  for_each_mixed_cell(
+      valid,
+      [&](int x, int y, int z, double* a) {
         for (int i = 0; i < 8; ++i)
           a[i] = corner_value(decoded, c.around, x + (i & 1), y + ((i >> 1) & 1), z + ((i >> 2) & 1), iso);
-        int m2, d;
-        cell::classify(a, m2, d);
-        const cell::LoopSet& ls = cell::loops_for(m2, d);
+      },
+      [&](int, int, int, const cell::LoopSet& ls) {
+        ++c.cells;
         c.triangles += ls.fan_triangles;
         c.centres += ls.centre_vertices;
-      }
-    }
+      });
 }
 
 // Where each brick's output starts in the result (bricks + 1 entries each).
@@ -163,17 +176,25 @@ void write_brick(const NarrowBand& band, const DecodedBand& decoded, std::uint32
   std::array<std::uint32_t, 3>* tri = r.mesh.triangles.data() + at.triangle[b];
   std::array<Vec3d, 12> pos;
   std::array<std::uint32_t, 12> index;
-  for_each_mixed_cell(t, s.valid, iso, [&](int x, int y, int z, const cell::LoopSet& ls) {
+  auto corners = [&](int x, int y, int z, double* a) {
+    const int p0 = CellTile::index(x, y, z);
+    for (int i = 0; i < 8; ++i) a[i] = double(t.values[p0 + kCornerOffset[i]]) - iso;
+  };
+  for_each_mixed_cell(s.valid, corners, [&](int x, int y, int z, const cell::LoopSet& ls) {
+    const int p0 = CellTile::index(x, y, z);
     if (tri_end - tri < ls.fan_triangles || vertex_end - vertex < ls.centre_vertices) throw differs();
+    const std::uint32_t* const cell_vertex = s.vertex_of_edge.data() + 3 * p0;
+    const double* const cell_s = s.edges.s.data() + 3 * p0;
     for (int l = 0; l < ls.loop_count; ++l) {
       const int n = ls.length[l];
       const std::uint8_t* edges = &ls.edges[ls.begin[l]];
-      for (int i = 0; i < n; ++i) {
-        const int c = cell::edge_lower_corner(edges[i]);
-        const int ex = x + (c & 1), ey = y + ((c >> 1) & 1), ez = z + ((c >> 2) & 1);
-        index[i] = s.vertex_of_edge[std::size_t(3 * CellTile::index(ex, ey, ez) + (edges[i] >> 2))];
-        if (n > 3) pos[i] = s.edges.point(ex, ey, ez, edges[i] >> 2);
-      }
+      for (int i = 0; i < n; ++i) index[i] = cell_vertex[kCellEdges[edges[i]].slot];
+      if (n > 3)
+        for (int i = 0; i < n; ++i) {  // EdgeCrossings::point of the edge
+          const CellEdge& e = kCellEdges[edges[i]];
+          pos[i] = {double(x + e.dx), double(y + e.dy), double(z + e.dz)};
+          pos[i][e.axis] += cell_s[e.slot];
+        }
       if (n == 3) {
         *tri++ = {index[0], index[1], index[2]};
         continue;

@@ -255,61 +255,24 @@ inline double max_cos_from_squares(double a2, double b2, double c2) {
 // Quad p0 p1 p2 p3: true when the diagonal p0-p2 is the Delaunay one (the angles at p1 and p3
 // facing it sum to at most pi: cot a1 + cot a3 >= 0), which for a planar convex quad is the
 // split that maximises the smallest angle. Two square roots, no division.
+// Both square roots in one instruction where SSE2 has it (the same correctly rounded values;
+// the scalar form waited on one, then the other: the quads' split was ~5 % of marching cubes).
 inline bool split_02(const Vec3d* p) {
   const Vec3d u1 = p[0] - p[1], v1 = p[2] - p[1], u3 = p[0] - p[3], v3 = p[2] - p[3];
-  const double s1 = length(cross(u1, v1)), s3 = length(cross(u3, v3));
+  const Vec3d c1 = cross(u1, v1), c3 = cross(u3, v3);
+#if defined(__SSE2__)
+  alignas(16) double s[2];
+  _mm_store_pd(s, _mm_sqrt_pd(_mm_set_pd(dot(c3, c3), dot(c1, c1))));
+  const double s1 = s[0], s3 = s[1];
+#else
+  const double s1 = std::sqrt(dot(c1, c1)), s3 = std::sqrt(dot(c3, c3));
+#endif
   return dot(u1, v1) * s3 + dot(u3, v3) * s1 >= 0.0;
 }
 
 // Fan apex for a polygon of n in [4, 12] vertices that maximises the smallest angle (quads:
-// the Delaunay diagonal, fan from 0 or 1). Squared distances are computed once per pair; the
-// n (n - 2) fan triangles' smallest-angle cosines are evaluated four at a time in float (the
-// scalar double loop, one square root and one division per triangle, was ~7 % of marching
-// cubes on knot.off R = 512). First apex wins ties.
-inline int best_fan_start(const Vec3d* p, int n) {
-  if (n == 4) return split_02(p) ? 0 : 1;
-  float d2[12][12];
-  for (int i = 0; i < n; ++i)
-    for (int j = i + 1; j < n; ++j) {
-      const Vec3d e = p[j] - p[i];
-      d2[i][j] = d2[j][i] = float(dot(e, e));
-    }
-  const int per = n - 2;
-  alignas(16) float sa[124], sb[124], sc[124], cosine[124];  // count <= 120, padded to 4
-  int t = 0;
-  for (int s = 0; s < n; ++s)
-    for (int i = 1; i <= per; ++i) {
-      const int b = s + i < n ? s + i : s + i - n, c = s + i + 1 < n ? s + i + 1 : s + i + 1 - n;
-      sa[t] = d2[s][b], sb[t] = d2[b][c], sc[t] = d2[c][s];
-      ++t;
-    }
-  for (; t % 4 != 0; ++t) sa[t] = sb[t] = sc[t] = 1.0f;
-#if defined(__SSE2__)
-  const __m128 zero = _mm_setzero_ps(), half = _mm_set1_ps(0.5f), one = _mm_set1_ps(1.0f);
-  for (int k = 0; k < t; k += 4) {
-    const __m128 a = _mm_load_ps(sa + k), b = _mm_load_ps(sb + k), c = _mm_load_ps(sc + k);
-    const __m128 lo = _mm_min_ps(_mm_min_ps(a, b), c), hi = _mm_max_ps(_mm_max_ps(a, b), c);
-    const __m128 mid = _mm_max_ps(_mm_min_ps(a, b), _mm_min_ps(_mm_max_ps(a, b), c));
-    const __m128 prod = _mm_mul_ps(hi, mid);
-    const __m128 q = _mm_div_ps(_mm_mul_ps(_mm_sub_ps(_mm_add_ps(hi, mid), lo), half), _mm_sqrt_ps(prod));
-    const __m128 ok = _mm_and_ps(_mm_cmpgt_ps(lo, zero), _mm_cmpgt_ps(prod, zero));  // else degenerate: 1
-    _mm_store_ps(cosine + k, _mm_or_ps(_mm_and_ps(ok, q), _mm_andnot_ps(ok, one)));
-  }
-#else
-  for (int k = 0; k < t; ++k) cosine[k] = float(max_cos_from_squares(sa[k], sb[k], sc[k]));
-#endif
-  int best = 0;
-  float best_cos = 2.0f;
-  for (int s = 0; s < n; ++s) {
-    float worst = -2.0f;
-    for (int i = 0; i < per; ++i) worst = std::max(worst, cosine[s * per + i]);
-    if (worst < best_cos) {
-      best_cos = worst;
-      best = s;
-    }
-  }
-  return best;
-}
+// the Delaunay diagonal, fan from 0 or 1). First apex wins ties. surface/fan_choice.cpp.
+int best_fan_start(const Vec3d* p, int n);
 
 // Per-thread storage for the bricks' outputs until the merge: a brick's arrays, built in
 // reused scratch vectors, are copied into the thread's chunks (kChunkBytes each, huge pages

@@ -4,6 +4,7 @@
 // neighbours, random fields with ambiguous faces, and several iso levels.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <random>
 #include <vector>
 
@@ -53,6 +54,12 @@ void expect_masks_match_values(const NarrowBand& band, double iso, const char* w
   int mixed = 0;
   for (std::uint32_t b = 0; b < band.brick_count(); ++b) {
     gather_cell_tile(band, b, tile, decoded.values.values());
+    // The row-copy gather from decoded bricks against the general box gather from the band.
+    CellTile plain;
+    gather_cell_tile(band, b, plain);
+    ASSERT_TRUE(std::equal(plain.values.begin(), plain.values.begin() + CellTile::kSize, tile.values.begin()))
+        << "brick " << b;
+    ASSERT_EQ(plain.active_rows, tile.active_rows) << "brick " << b;
     from_values.compute(tile, iso);
     const NeighborSigns signs =
         resolve_neighbor_signs(band, tile.around, -CellTile::kHalo, CellTile::kDim - CellTile::kHalo);
@@ -124,6 +131,24 @@ TEST(CellLoops, UnambiguousTriangleCountsMatchTheLoops) {
   }
   EXPECT_GT(ambiguous, 0);
   EXPECT_LT(ambiguous, 256);
+}
+
+TEST(CellLoops, LookupMatchesClassify) {
+  const cell::LoopLookup& lookup = cell::loop_lookup();
+  for (int m = 0; m < 256; ++m) ASSERT_EQ(int(lookup.ambiguous[m]), cell::ambiguous_faces(m)) << "mask " << m;
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> value(-1.0, 1.0);
+  int with_decisions = 0;
+  for (int trial = 0; trial < 20000; ++trial) {
+    double a[8];
+    for (double& v : a) v = value(rng);
+    int m, d;
+    cell::classify(a, m, d);
+    ASSERT_EQ(cell::face_decisions(a, lookup.ambiguous[m]), d) << "trial " << trial;
+    ASSERT_EQ(&lookup.at(m, d), &cell::loops_for(m, d));
+    with_decisions += d != 0;
+  }
+  EXPECT_GT(with_decisions, 100);
 }
 
 }  // namespace
