@@ -42,10 +42,21 @@ inline void prefault_for_write(const void* data, std::size_t bytes) {
 #if !defined(MADV_POPULATE_WRITE)
   constexpr int MADV_POPULATE_WRITE = 23;
 #endif
-  constexpr std::uintptr_t kPage = 4096;
+  constexpr std::uintptr_t kPage = 4096, kHuge = std::uintptr_t{1} << 21;
   const std::uintptr_t begin = (reinterpret_cast<std::uintptr_t>(data) + kPage - 1) & ~(kPage - 1);
   const std::uintptr_t end = (reinterpret_cast<std::uintptr_t>(data) + bytes) & ~(kPage - 1);
-  if (end > begin) madvise(reinterpret_cast<void*>(begin), end - begin, MADV_POPULATE_WRITE);
+  // The whole huge pages fault in 2 MiB at a time on first touch; populate the rest.
+  const std::uintptr_t huge_begin = (reinterpret_cast<std::uintptr_t>(data) + kHuge - 1) & ~(kHuge - 1);
+  const std::uintptr_t huge_end = (reinterpret_cast<std::uintptr_t>(data) + bytes) & ~(kHuge - 1);
+  auto populate = [](std::uintptr_t b, std::uintptr_t e) {
+    if (e > b) madvise(reinterpret_cast<void*>(b), e - b, MADV_POPULATE_WRITE);
+  };
+  if (huge_end > huge_begin) {
+    populate(begin, huge_begin);
+    populate(huge_end, end);
+  } else {
+    populate(begin, end);
+  }
 #endif
 }
 

@@ -317,16 +317,14 @@ NeighborSigns resolve_neighbor_signs(const NarrowBand& band, const Neighborhood&
 
 DecodedBricks decode_bricks(const NarrowBand& band) {
   DecodedBricks out;
-  out.size = band.brick_count() * std::size_t(kBrickVoxels);
-  // Not value-initialised: every entry is written below, in parallel; the pages are faulted
-  // in first by one call (prefault_for_write), not by a trap per page.
-  out.data.reset(new float[std::max<std::size_t>(out.size, 1)]);
-  prefault_for_write(out.data.get(), out.size * sizeof(float));
+  // Not value-initialised: every entry is written below, in parallel; the pages (huge ones
+  // where the buffer is large) are faulted in first by one call, not by a trap per page.
+  resize_with_huge_pages(out.data, band.brick_count() * std::size_t(kBrickVoxels));
   tbb::parallel_for(tbb::blocked_range<std::uint32_t>(0, std::uint32_t(band.brick_count()), 64),
                     [&](const tbb::blocked_range<std::uint32_t>& r) {
                       for (std::uint32_t b = r.begin(); b != r.end(); ++b)
                         decode_brick(band, b,
-                                     std::span<float, kBrickVoxels>(out.data.get() + std::size_t(b) * kBrickVoxels,
+                                     std::span<float, kBrickVoxels>(out.data.data() + std::size_t(b) * kBrickVoxels,
                                                                     kBrickVoxels));
                     });
   return out;

@@ -16,6 +16,7 @@
 #include <span>
 #include <vector>
 
+#include "core/uninitialized_vector.hpp"
 #include "grid/narrow_band.hpp"
 
 namespace levelset {
@@ -70,9 +71,8 @@ void decode_brick_portable(const NarrowBand& band, std::uint32_t brick, std::spa
 // instead of decoding each neighbour again (a 14^3 box decodes 5.4 bricks' worth of voxels).
 // Memory: 2 KiB per brick (huge pages advised when large).
 struct DecodedBricks {
-  std::unique_ptr<float[]> data;
-  std::size_t size = 0;
-  std::span<const float> values() const { return {data.get(), size}; }
+  UninitializedVector<float> data;
+  std::span<const float> values() const { return {data.data(), data.size()}; }
 };
 DecodedBricks decode_bricks(const NarrowBand& band);
 // Which part of the box a gather fills: all of it, or the star (the brick and the parts of its

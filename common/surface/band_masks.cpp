@@ -33,7 +33,7 @@ DecodedBand decode_band(const NarrowBand& band, double iso) {
   DecodedBand out;
   out.values = decode_bricks(band);
   const std::size_t nb = band.brick_count();
-  out.inside.reset(new std::uint64_t[std::max<std::size_t>(8 * nb, 1)]);  // written below
+  resize_with_huge_pages(out.inside, 8 * nb);  // written below
   // Bit 0: some active value < iso; bit 1: some active value >= iso.
   std::vector<std::uint8_t> sides(nb);
   const float below = ValidCells::float_below(iso);
@@ -42,7 +42,7 @@ DecodedBand decode_band(const NarrowBand& band, double iso) {
       const BrickMask& active = band.bricks()[b].active;
       std::uint64_t in = 0, out_side = 0;
       for (int w = 0; w < 8; ++w) {
-        const std::uint64_t bits = below_bits(out.values.data.get() + b * kBrickVoxels + 64 * std::size_t(w), below);
+        const std::uint64_t bits = below_bits(out.values.data.data() + b * kBrickVoxels + 64 * std::size_t(w), below);
         out.inside[8 * b + std::size_t(w)] = bits;
         in |= bits & active.words[std::size_t(w)];
         out_side |= ~bits & active.words[std::size_t(w)];

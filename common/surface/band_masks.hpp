@@ -24,10 +24,10 @@ namespace levelset::surface_detail {
 
 struct DecodedBand {
   DecodedBricks values;
-  std::unique_ptr<std::uint64_t[]> inside;  // 8 words per brick, BrickMask layout
+  UninitializedVector<std::uint64_t> inside;  // 8 words per brick, BrickMask layout
   std::vector<std::uint8_t> work;           // 1 where the brick can own cells or edges at iso
   std::span<const std::uint64_t, 8> inside_words(std::uint32_t b) const {
-    return std::span<const std::uint64_t, 8>(inside.get() + 8 * std::size_t(b), 8);
+    return std::span<const std::uint64_t, 8>(inside.data() + 8 * std::size_t(b), 8);
   }
 };
 

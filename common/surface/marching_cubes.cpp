@@ -16,6 +16,7 @@
 #include <tbb/enumerable_thread_specific.h>
 
 #include "core/error.hpp"
+#include "core/uninitialized_vector.hpp"
 #include "surface/band_masks.hpp"
 #include "surface/cell_loops.hpp"
 #include "surface/cell_tile.hpp"
@@ -153,7 +154,15 @@ void write_brick(const NarrowBand& band, const DecodedBand& decoded, std::uint32
   // Each crossing edge's vertex index once (the cells' loops reference an edge up to 4 times):
   // its owner brick's first vertex plus the edge's rank among the owner's owned slots. Both
   // ends of a crossing edge are active, so the owner is allocated.
+  // The brick's own edges come in slot order, so their rank is a running count.
+  const SlotBits<kEdgeSlots>& own = counts[b].owned;
+  std::uint32_t own_rank = 0;
   s.edges.compute(t, s.valid, iso, 0, [&](int x, int y, int z, int a, int p) {
+    if (((x | y | z) & kBrickDim) == 0) {
+      s.vertex_of_edge[std::size_t(3 * p + a)] = at.vertex[b] + own_rank;
+      own_rank += own.test(3 * local_index(x, y, z) + a) ? 1u : 0u;
+      return;
+    }
     const std::uint32_t owner = t.around[std::size_t(Neighborhood::slot(x >> 3, y >> 3, z >> 3))];
     s.vertex_of_edge[std::size_t(3 * p + a)] =
         at.vertex[owner] + counts[owner].owned.rank(3 * local_index(x & 7, y & 7, z & 7) + a);
@@ -175,7 +184,7 @@ void write_brick(const NarrowBand& band, const DecodedBand& decoded, std::uint32
   std::uint32_t centre = at.vertex[b] + counts[b].edge_vertices;
   std::array<std::uint32_t, 3>* tri = r.mesh.triangles.data() + at.triangle[b];
   std::array<Vec3d, 12> pos;
-  std::array<std::uint32_t, 12> index;
+  std::array<std::uint32_t, 24> index;  // a loop's vertex indices, twice (fans wrap without %)
   auto corners = [&](int x, int y, int z, double* a) {
     const int p0 = CellTile::index(x, y, z);
     for (int i = 0; i < 8; ++i) a[i] = double(t.values[p0 + kCornerOffset[i]]) - iso;
@@ -188,7 +197,7 @@ void write_brick(const NarrowBand& band, const DecodedBand& decoded, std::uint32
     for (int l = 0; l < ls.loop_count; ++l) {
       const int n = ls.length[l];
       const std::uint8_t* edges = &ls.edges[ls.begin[l]];
-      for (int i = 0; i < n; ++i) index[i] = cell_vertex[kCellEdges[edges[i]].slot];
+      for (int i = 0; i < n; ++i) index[i] = index[i + n] = cell_vertex[kCellEdges[edges[i]].slot];
       if (n > 3)
         for (int i = 0; i < n; ++i) {  // EdgeCrossings::point of the edge
           const CellEdge& e = kCellEdges[edges[i]];
@@ -205,12 +214,12 @@ void write_brick(const NarrowBand& band, const DecodedBand& decoded, std::uint32
         c = c / double(n);
         *vertex++ = corner + c * h;
         *normal++ = normalized_f(gradient_at(t, c, x, y, z));
-        for (int i = 0; i < n; ++i) *tri++ = {centre, index[i], index[(i + 1) % n]};
+        for (int i = 0; i < n; ++i) *tri++ = {centre, index[i], index[i + 1]};
         ++centre;
         continue;
       }
       const int f = best_fan_start(pos.data(), n);
-      for (int i = 1; i + 1 < n; ++i) *tri++ = {index[f], index[(f + i) % n], index[(f + i + 1) % n]};
+      for (int i = 1; i + 1 < n; ++i) *tri++ = {index[f], index[f + i], index[f + i + 1]};
     }
   });
   if (vertex != vertex_end || tri != tri_end) throw differs();
@@ -229,12 +238,9 @@ SurfaceResult marching_cubes(const NarrowBand& band, const MarchingCubesOptions&
   const DecodedBand decoded = decode_band(band, options.iso);
   // Not value-initialised (a serial zeroing pass over ~430 bytes per brick): the counting pass
   // constructs every brick's entry, in parallel.
-  const std::unique_ptr<BrickCount[], void (*)(BrickCount*)> count_store(
-      static_cast<BrickCount*>(::operator new[](std::max<std::size_t>(nb, 1) * sizeof(BrickCount))),
-      [](BrickCount* p) { ::operator delete[](p); });
-  static_assert(std::is_trivially_destructible_v<BrickCount>);
-  prefault_for_write(count_store.get(), nb * sizeof(BrickCount));
-  const std::span<BrickCount> counts(count_store.get(), nb);
+  const UninitializedArray<BrickCount> count_store(nb);
+  prefault_for_write(count_store.data(), nb * sizeof(BrickCount));
+  const std::span<BrickCount> counts(count_store.data(), nb);
   for_brick_batches(nb, options.progress, "marching_cubes", [&](std::uint32_t b) {
     BrickCount* c = new (&counts[b]) BrickCount{};
     if (decoded.work[b]) count_brick(band, decoded, b, options.iso, scratch.local(), *c);

@@ -131,12 +131,14 @@ struct ValidCells {
     for (int a = 0; a < 3; ++a) out |= spread3((((c[a] & used[a]) >> kH) & 0xffu)) << a;
     return out;
   }
-  // Bit x of m (8 bits) moved to bit 3 x.
-  static std::uint32_t spread3(std::uint32_t m) {
-    std::uint32_t out = 0;
-    for (; m != 0; m &= m - 1) out |= 1u << (3 * std::countr_zero(m));
-    return out;
-  }
+  // Bit x of m (8 bits) moved to bit 3 x (a table: the bit loop was ~3 % of marching cubes).
+  static std::uint32_t spread3(std::uint32_t m) { return kSpread3[m & 0xffu]; }
+  static constexpr std::array<std::uint32_t, 256> kSpread3 = [] {
+    std::array<std::uint32_t, 256> t{};
+    for (std::uint32_t m = 0; m < 256; ++m)
+      for (int x = 0; x < 8; ++x) t[m] |= ((m >> x) & 1u) << (3 * x);
+    return t;
+  }();
   // Bits of crossing_edges for x in [lo, hi).
   static constexpr std::uint32_t x_bits(int lo, int hi) { return ((1u << (hi + 1)) - 1u) & ~((1u << (lo + 1)) - 1u); }
   // Any of the 4 cells around the edge from (x,y,z) along axis a is valid.
