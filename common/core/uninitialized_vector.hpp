@@ -5,12 +5,6 @@
 // zeroes all n elements on one thread, which on a 2-core machine is a serial pass over memory
 // (and where the pages are fresh, all their first-touch faults on that thread). assign(),
 // push_back() and insert() initialise as usual.
-//
-// Blocks of 2 MiB and more are placed on whole transparent huge pages: aligned to 2 MiB,
-// rounded up to a multiple of it and advised (core/huge_pages.hpp), so fresh memory faults in
-// 2 MiB at a time over the whole buffer. A plain heap block gets the advice only for the huge
-// pages that happen to lie inside it (a 4.6 MB block: 2 of them at best) and its ends fault in
-// 4 KiB at a time, which on this project's virtual machines costs ~10 us per page.
 #pragma once
 
 #include <cstddef>
@@ -19,8 +13,6 @@
 #include <type_traits>
 #include <utility>
 #include <vector>
-
-#include "core/huge_pages.hpp"
 
 namespace levelset {
 
@@ -31,19 +23,6 @@ struct DefaultInitAllocator : Base {
   struct rebind {
     using other = DefaultInitAllocator<U, typename std::allocator_traits<Base>::template rebind_alloc<U>>;
   };
-  static constexpr std::size_t kHuge = std::size_t{2} << 20;
-  static std::size_t huge_bytes(std::size_t n) { return (n * sizeof(T) + kHuge - 1) & ~(kHuge - 1); }
-  T* allocate(std::size_t n) {
-    if (n * sizeof(T) < kHuge) return std::allocator_traits<Base>::allocate(static_cast<Base&>(*this), n);
-    if (n > std::size_t(-1) / 2 / sizeof(T)) throw std::bad_array_new_length();
-    void* p = ::operator new(huge_bytes(n), std::align_val_t(kHuge));
-    advise_huge_pages(p, huge_bytes(n));
-    return static_cast<T*>(p);
-  }
-  void deallocate(T* p, std::size_t n) noexcept {
-    if (n * sizeof(T) < kHuge) return std::allocator_traits<Base>::deallocate(static_cast<Base&>(*this), p, n);
-    ::operator delete(p, huge_bytes(n), std::align_val_t(kHuge));
-  }
   // Value-less construction default-initialises (no zeroing for trivial types).
   template <class U>
   void construct(U* p) noexcept(std::is_nothrow_default_constructible_v<U>) {

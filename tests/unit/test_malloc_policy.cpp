@@ -3,13 +3,10 @@
 // (above any mmap threshold glibc accepts) and unmap it on free.
 #include <gtest/gtest.h>
 
-#include <cstdint>
 #include <cstdlib>
-#include <numeric>
 #include <cstring>
 
 #include "core/malloc_policy.hpp"
-#include "core/uninitialized_vector.hpp"
 
 #if defined(__GLIBC__)
 #include <malloc.h>
@@ -38,26 +35,6 @@ TEST(MallocPolicy, FreedLargeBuffersStayInTheProcess) {
   EXPECT_EQ(second, first);
   std::free(second);
 #endif
-}
-
-// UninitializedVector places a block of 2 MiB or more on whole huge pages (aligned to 2 MiB,
-// its size rounded up); smaller ones stay plain. Growth across the threshold keeps the data
-// and frees each block through the path that allocated it.
-TEST(HugePagePlacement, LargeUninitializedVectorsStartOnAHugePageBoundary) {
-  constexpr std::uintptr_t kHuge = std::uintptr_t{2} << 20;
-  UninitializedVector<float> small(1000);
-  std::iota(small.begin(), small.end(), 0.0f);
-  UninitializedVector<float> large(std::size_t{3} << 20);  // 12 MB
-  EXPECT_EQ(reinterpret_cast<std::uintptr_t>(large.data()) % kHuge, 0u);
-  large[large.size() - 1] = 7.0f;  // the whole range is writable
-  for (int round = 0; round < 2; ++round) {
-    small.resize(small.size() * 64);  // 64 000 floats (256 KB), then 4 096 000 (16 MB)
-    EXPECT_EQ(small[999], 999.0f);
-  }
-  EXPECT_EQ(reinterpret_cast<std::uintptr_t>(small.data()) % kHuge, 0u);
-  const UninitializedArray<std::uint64_t> raw(std::size_t{1} << 19);  // 4 MB
-  EXPECT_EQ(reinterpret_cast<std::uintptr_t>(raw.data()) % kHuge, 0u);
-  EXPECT_EQ(large[large.size() - 1], 7.0f);
 }
 
 }  // namespace
