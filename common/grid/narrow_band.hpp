@@ -113,6 +113,17 @@ class NarrowBand {
   bool is_inside(const Coord& c) const;                 // sign anywhere, band or not
   // Sign of a voxel in an unallocated brick (the x-row rule above).
   bool is_inside_unallocated(const Coord& c) const;
+  // The same when allocated brick `lower` is the -x neighbour of c's (unallocated) brick: the
+  // search then ends at lower + 1 (keys run along x), so it is O(1) instead of O(log bricks).
+  bool is_inside_unallocated_next_to(std::uint32_t lower, const Coord& c) const {
+    const Coord bc = brick_of(c);
+    if (!brick_in_range(bc)) return far_inside_;
+    const int ly = c.y & 7, lz = c.z & 7;
+    const std::uint32_t next = lower + 1;
+    if (next < bricks_.size() && bricks_[next].coord.y == bc.y && bricks_[next].coord.z == bc.z)
+      return voxel_inside(next, local_index(0, ly, lz));  // next brick along +x: first column
+    return voxel_inside(lower, local_index(7, ly, lz));   // the lower neighbour: last column
+  }
 
   // Sets a value, activating the voxel if needed (see cost above). Rejects non-finite values
   // and coordinates outside the index range with Error{InvalidArgument}.

@@ -180,7 +180,11 @@ bool unallocated_inside(const NarrowBand& band, const Neighborhood& around, cons
   const std::uint32_t next = d.x < 1 ? around[std::size_t(Neighborhood::slot(d.x + 1, d.y, d.z))] : kNoBrick;
   if (next != kNoBrick) return band.voxel_inside(next, local_index(0, nlo[1], nlo[2]));
   const Coord self = band.bricks()[around[std::size_t(Neighborhood::slot(0, 0, 0))]].coord;
-  return band.is_inside_unallocated(brick_origin(self + d) + Coord{nlo[0], nlo[1], nlo[2]});
+  const Coord voxel = brick_origin(self + d) + Coord{nlo[0], nlo[1], nlo[2]};
+  // With the -x neighbour known, no search (the search was ~4 % of marching cubes).
+  const std::uint32_t lower = d.x > -1 ? around[std::size_t(Neighborhood::slot(d.x - 1, d.y, d.z))] : kNoBrick;
+  if (lower != kNoBrick) return band.is_inside_unallocated_next_to(lower, voxel);
+  return band.is_inside_unallocated(voxel);
 }
 
 // Local range [nlo, nhi) per axis of neighbour d that falls into the box [lo, hi)^3; false

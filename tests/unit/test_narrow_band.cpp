@@ -10,6 +10,7 @@
 #include <tbb/task_arena.h>
 
 #include "core/error.hpp"
+#include "grid/band_builder.hpp"
 #include "grid/narrow_band.hpp"
 #include "shape_band.hpp"
 
@@ -274,6 +275,54 @@ TEST(BuildFromSdf, CancellationStopsTheBuild) {
     EXPECT_EQ(e.code(), ErrorCode::Cancelled);
   }
   EXPECT_GE(reports, 2);
+}
+
+// The O(1) sign of an unallocated brick next to its -x neighbour equals the row search, on
+// bands whose rows have gaps of every length, random signs (the rule, not the invariant, is
+// what is compared), both far_inside settings and bricks at the edge of the index range.
+TEST(NarrowBand, UnallocatedSignNextToItsLowerNeighbourMatchesTheSearch) {
+  std::mt19937 rng(5);
+  std::uniform_int_distribution<int> coin(0, 2);
+  int compared = 0, via_next = 0, via_lower = 0;
+  for (bool far_inside : {false, true}) {
+    GridFrame frame;
+    frame.voxel_size = 1.0;
+    frame.half_width = 3.0;
+    BandBuilder builder(frame);
+    const int edge = kBrickCoordLimit - 1;  // the last brick coordinate in range
+    for (int bz = 0; bz < 3; ++bz)
+      for (int by = 0; by < 3; ++by)
+        for (int bx = 0; bx < 9; ++bx) {
+          if (coin(rng) == 0) continue;
+          BrickMask active, inside;
+          float dense[kBrickVoxels];
+          for (int n = 0; n < kBrickVoxels; ++n) {
+            dense[n] = coin(rng) == 0 ? -1.0f : 1.0f;
+            active.assign(n, coin(rng) != 0);
+            inside.assign(n, dense[n] < 0.0f);
+          }
+          const int x = bz == 2 && by == 2 ? edge - 8 + bx : bx;  // one row ends at the range's edge
+          builder.add_brick({x, by, bz}, active, inside, dense);
+        }
+    const NarrowBand band = builder.finish(far_inside);
+    for (std::uint32_t b = 0; b < band.brick_count(); ++b) {
+      const Coord above = band.bricks()[b].coord + Coord{1, 0, 0};
+      if (brick_in_range(above) && band.find_brick(above) != kNoBrick) continue;
+      for (int lz = 0; lz < kBrickDim; ++lz)
+        for (int ly = 0; ly < kBrickDim; ++ly) {
+          const Coord c = brick_origin(above) + Coord{3, ly, lz};
+          ASSERT_EQ(band.is_inside_unallocated_next_to(b, c), band.is_inside_unallocated(c))
+              << "brick " << b << " row " << ly << " " << lz << " far_inside " << far_inside;
+          ++compared;
+        }
+      const bool next_in_row = b + 1 < band.brick_count() && band.bricks()[b + 1].coord.y == above.y &&
+                               band.bricks()[b + 1].coord.z == above.z;
+      (next_in_row ? via_next : via_lower) += 1;
+    }
+  }
+  EXPECT_GT(compared, 1000);
+  EXPECT_GT(via_next, 5);   // a gap, then more bricks in the row: the next brick's first column
+  EXPECT_GT(via_lower, 5);  // the row ends: the lower brick's last column
 }
 
 }  // namespace
