@@ -8,6 +8,9 @@
 #include <numeric>
 #include <vector>
 
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
 #include "core/error.hpp"
 
 namespace levelset {
@@ -33,24 +36,39 @@ struct VertexTriangles {
   }
 };
 
-// Area, volume and triangle quality (see the header).
-void measure_triangles(const TriangleMesh& mesh, MeshMeasures& m) {
-  double min_angle = 180.0, sum_min_angle = 0.0, max_aspect = 0.0;
-  // The signed tetrahedron volumes are taken about the mesh's centre, not the world origin: far
-  // from the origin (a unit cube at 5e6) the products of large coordinates cancel catastrophically.
-  const BBox box = mesh.bounds();
-  const Vec3d origin = box.empty() ? Vec3d{} : 0.5 * (box.min + box.max);
-  for (const auto& t : mesh.triangles) {
+// Work is split into fixed chunks whose partial results are combined in chunk order, so the
+// measures (floating-point sums included) do not depend on the thread count.
+constexpr std::size_t kChunk = 16384;
+
+template <typename Part, typename F>
+std::vector<Part> chunk_parts(std::size_t items, F&& f) {
+  std::vector<Part> parts((items + kChunk - 1) / kChunk);
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, parts.size(), 1), [&](const tbb::blocked_range<std::size_t>& r) {
+    for (std::size_t c = r.begin(); c != r.end(); ++c) f(c * kChunk, std::min(items, (c + 1) * kChunk), parts[c]);
+  });
+  return parts;
+}
+
+// Area, volume and triangle quality (see the header) of triangles [begin, end).
+struct TrianglePart {
+  double area = 0.0, volume = 0.0, min_angle = 180.0, sum_min_angle = 0.0, max_aspect = 0.0;
+  std::uint64_t degenerate = 0;
+};
+
+void measure_triangle_range(const TriangleMesh& mesh, const Vec3d& origin, std::size_t begin, std::size_t end,
+                            TrianglePart& p) {
+  for (std::size_t f = begin; f < end; ++f) {
+    const auto& t = mesh.triangles[f];
     const Vec3d &a = mesh.vertices[t[0]], &b = mesh.vertices[t[1]], &c = mesh.vertices[t[2]];
     const Vec3d n = cross(b - a, c - a);
     const double area2 = length(n);
-    m.area += 0.5 * area2;
-    m.volume += dot(a - origin, cross(b - origin, c - origin)) / 6.0;
+    p.area += 0.5 * area2;
+    p.volume += dot(a - origin, cross(b - origin, c - origin)) / 6.0;
     const double la = length(b - c), lb = length(c - a), lc = length(a - b);
     if (!(area2 > 0.0)) {
-      ++m.degenerate_triangles;
-      min_angle = 0.0;
-      max_aspect = std::numeric_limits<double>::infinity();
+      ++p.degenerate;
+      p.min_angle = 0.0;
+      p.max_aspect = std::numeric_limits<double>::infinity();
       continue;
     }
     auto cosine = [](double opp, double s1, double s2) {
@@ -59,10 +77,28 @@ void measure_triangles(const TriangleMesh& mesh, MeshMeasures& m) {
     // The smallest angle has the largest cosine (one arc cosine per triangle).
     const double mn = std::acos(std::max({cosine(la, lb, lc), cosine(lb, lc, la), cosine(lc, la, lb)})) * 180.0 /
                       std::numbers::pi;
-    min_angle = std::min(min_angle, mn);
-    sum_min_angle += mn;
+    p.min_angle = std::min(p.min_angle, mn);
+    p.sum_min_angle += mn;
     const double aspect = std::max({la, lb, lc}) * (la + lb + lc) / (4.0 * std::sqrt(3.0) * 0.5 * area2);
-    max_aspect = std::max(max_aspect, aspect);
+    p.max_aspect = std::max(p.max_aspect, aspect);
+  }
+}
+
+void measure_triangles(const TriangleMesh& mesh, MeshMeasures& m) {
+  // The signed tetrahedron volumes are taken about the mesh's centre, not the world origin: far
+  // from the origin (a unit cube at 5e6) the products of large coordinates cancel catastrophically.
+  const BBox box = mesh.bounds();
+  const Vec3d origin = box.empty() ? Vec3d{} : 0.5 * (box.min + box.max);
+  double min_angle = 180.0, sum_min_angle = 0.0, max_aspect = 0.0;
+  for (const TrianglePart& p : chunk_parts<TrianglePart>(mesh.triangles.size(), [&](std::size_t b, std::size_t e, TrianglePart& p) {
+         measure_triangle_range(mesh, origin, b, e, p);
+       })) {
+    m.area += p.area;
+    m.volume += p.volume;
+    m.degenerate_triangles += p.degenerate;
+    min_angle = std::min(min_angle, p.min_angle);
+    sum_min_angle += p.sum_min_angle;
+    max_aspect = std::max(max_aspect, p.max_aspect);
   }
   if (m.faces > 0) {
     m.min_angle_deg = min_angle;
@@ -73,9 +109,14 @@ void measure_triangles(const TriangleMesh& mesh, MeshMeasures& m) {
 
 // Edges, counted at their lower vertex from its triangles (no global sort): each undirected
 // edge {lo, hi} is seen once per triangle using it, with the direction the triangle gives it.
-void count_edges(const TriangleMesh& mesh, const VertexTriangles& around, MeshMeasures& m) {
+struct EdgePart {
+  std::uint64_t edges = 0, boundary = 0, non_manifold = 0, misoriented = 0;
+};
+
+void count_edge_range(const TriangleMesh& mesh, const VertexTriangles& around, std::uint32_t begin, std::uint32_t end,
+                      EdgePart& m) {
   std::vector<std::uint64_t> ends;  // (hi << 1) | forward (lo -> hi in the triangle)
-  for (std::uint32_t v = 0; v + 1 < around.start.size(); ++v) {
+  for (std::uint32_t v = begin; v < end; ++v) {
     ends.clear();
     for (std::uint32_t k = around.start[v]; k < around.start[v + 1]; ++k) {
       // A triangle holding v twice is listed twice in a row: its edges are taken once.
@@ -96,11 +137,23 @@ void count_edges(const TriangleMesh& mesh, const VertexTriangles& around, MeshMe
       while (j < ends.size() && (ends[j] >> 1) == (ends[i] >> 1)) fwd += int(ends[j++] & 1u);
       const std::size_t count = j - i;
       ++m.edges;
-      if (count == 1) ++m.boundary_edges;
-      else if (count > 2) ++m.non_manifold_edges;
-      else if (fwd != 1) ++m.misoriented_edges;
+      if (count == 1) ++m.boundary;
+      else if (count > 2) ++m.non_manifold;
+      else if (fwd != 1) ++m.misoriented;
       i = j;
     }
+  }
+}
+
+void count_edges(const TriangleMesh& mesh, const VertexTriangles& around, MeshMeasures& m) {
+  const std::size_t nv = around.start.size() - 1;
+  for (const EdgePart& p : chunk_parts<EdgePart>(nv, [&](std::size_t b, std::size_t e, EdgePart& p) {
+         count_edge_range(mesh, around, std::uint32_t(b), std::uint32_t(e), p);
+       })) {
+    m.edges += p.edges;
+    m.boundary_edges += p.boundary;
+    m.non_manifold_edges += p.non_manifold;
+    m.misoriented_edges += p.misoriented;
   }
 }
 
@@ -138,12 +191,13 @@ bool link_is_cycle(const std::vector<std::array<std::uint32_t, 2>>& link, std::v
   return walked == n;
 }
 
-std::uint64_t non_manifold_vertices(const TriangleMesh& mesh, const VertexTriangles& around) {
+std::uint64_t non_manifold_vertex_range(const TriangleMesh& mesh, const VertexTriangles& around,
+                                        std::uint32_t begin, std::uint32_t end) {
   std::uint64_t count = 0;
   std::vector<std::array<std::uint32_t, 2>> link;
   std::vector<std::uint32_t> ends;
   std::vector<std::uint8_t> used;
-  for (std::uint32_t v = 0; v + 1 < around.start.size(); ++v) {
+  for (std::uint32_t v = begin; v < end; ++v) {
     if (around.start[v] == around.start[v + 1]) continue;  // not referenced
     link.clear();
     for (std::uint32_t k = around.start[v]; k < around.start[v + 1]; ++k) {
@@ -153,6 +207,15 @@ std::uint64_t non_manifold_vertices(const TriangleMesh& mesh, const VertexTriang
     }
     if (!link_is_cycle(link, ends, used)) ++count;
   }
+  return count;
+}
+
+std::uint64_t non_manifold_vertices(const TriangleMesh& mesh, const VertexTriangles& around) {
+  std::uint64_t count = 0;
+  for (const std::uint64_t c : chunk_parts<std::uint64_t>(around.start.size() - 1, [&](std::size_t b, std::size_t e, std::uint64_t& c) {
+         c = non_manifold_vertex_range(mesh, around, std::uint32_t(b), std::uint32_t(e));
+       }))
+    count += c;
   return count;
 }
 
