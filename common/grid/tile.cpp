@@ -37,30 +37,60 @@ constexpr std::array<std::uint32_t, 256> kActiveBefore = make_active_before();
 
 }  // namespace
 
+namespace {
+
+// Per slot of the 3x3x3 neighbourhood, the ways to reach it by one face link from a slot one
+// step nearer the centre (axis by axis, as the search below tries them), slots in the order
+// faces, edges, corners (each resolved after the ones it is reached from).
+struct SlotPaths {
+  std::uint8_t slot = 0, count = 0;
+  std::array<std::uint8_t, 3> from{}, face{};
+};
+
+constexpr std::array<SlotPaths, 26> make_slot_paths() {
+  std::array<SlotPaths, 26> out{};
+  int at = 0;
+  for (int axes = 1; axes <= 3; ++axes)
+    for (int k = 0; k < 27; ++k) {
+      const Coord d = Neighborhood::offset(k);
+      if ((d.x != 0) + (d.y != 0) + (d.z != 0) != axes) continue;
+      SlotPaths p;
+      p.slot = std::uint8_t(k);
+      for (int a = 0; a < 3; ++a) {
+        if (d[a] == 0) continue;
+        Coord nearer = d;
+        nearer[a] = 0;
+        p.from[p.count] = std::uint8_t(Neighborhood::slot(nearer.x, nearer.y, nearer.z));
+        p.face[p.count] = std::uint8_t(2 * a + (d[a] > 0 ? 1 : 0));
+        ++p.count;
+      }
+      out[std::size_t(at++)] = p;
+    }
+  return out;
+}
+
+constexpr std::array<SlotPaths, 26> kSlotPaths = make_slot_paths();
+
+}  // namespace
+
 Neighborhood brick_neighborhood(const NarrowBand& band, std::uint32_t brick) {
   Neighborhood n;
   n.fill(kNoBrick);
   n[Neighborhood::slot(0, 0, 0)] = brick;
   // Faces, then edges, then corners: each one face link from a resolved brick one step nearer;
   // a hash lookup only when every such path is unallocated (the brick may still exist).
-  for (int axes = 1; axes <= 3; ++axes)
-    for (int k = 0; k < 27; ++k) {
-      const Coord d = Neighborhood::offset(k);
-      if ((d.x != 0) + (d.y != 0) + (d.z != 0) != axes) continue;
-      std::uint32_t found = kNoBrick;
-      bool path = false;
-      for (int a = 0; a < 3 && found == kNoBrick; ++a) {
-        if (d[a] == 0) continue;
-        Coord nearer = d;
-        nearer[a] = 0;
-        const std::uint32_t from = n[std::size_t(Neighborhood::slot(nearer.x, nearer.y, nearer.z))];
-        if (from == kNoBrick) continue;
-        path = true;
-        found = band.neighbor(from, Face(2 * a + (d[a] > 0 ? 1 : 0)));
-      }
-      if (!path) found = band.find_brick(band.bricks()[brick].coord + d);
-      n[std::size_t(k)] = found;
+  for (const SlotPaths& p : kSlotPaths) {
+    std::uint32_t found = kNoBrick;
+    bool path = false;
+    for (int i = 0; i < p.count && found == kNoBrick; ++i) {
+      const std::uint32_t from = n[p.from[std::size_t(i)]];
+      if (from == kNoBrick) continue;
+      path = true;
+      found = band.neighbor(from, Face(p.face[std::size_t(i)]));
     }
+    if (!path) found = band.find_brick(band.bricks()[brick].coord + Neighborhood::offset(p.slot));
+    n[p.slot] = found;
+  }
   return n;
 }
 
