@@ -77,8 +77,10 @@ void for_each_mixed_cell(const ValidCells& valid, Corners&& corners, F&& f) {
                                      valid.inside_rows[std::size_t(ValidCells::row(y + 1, z + 1))]};
       for (std::uint32_t bits = (valid.mixed_row(y, z) >> ValidCells::kH) & 0xffu; bits != 0; bits &= bits - 1) {
         const int x = std::countr_zero(bits);
-        int m = 0;
-        for (int i = 0; i < 8; ++i) m |= int((rows[i >> 1] >> (x + (i & 1) + ValidCells::kH)) & 1u) << i;
+        // Corner i's inside bit is bit x + (i & 1) of row i >> 1: two corners per row.
+        const int at = x + ValidCells::kH;
+        const int m = int(((rows[0] >> at) & 3u) | (((rows[1] >> at) & 3u) << 2) | (((rows[2] >> at) & 3u) << 4) |
+                          (((rows[3] >> at) & 3u) << 6));
         int d = 0;
         if (const int ambiguous = loops.ambiguous[m]; ambiguous != 0) {
           double a[8];
