@@ -52,15 +52,14 @@ struct Scratch {
 };
 
 // The grid edges from voxels in [0, 8)^3 that cross iso and belong to a contoured cell, in slot
-// order: f(x, y, z, axis).
+// order (slot 3 local_index + axis, as the counting pass recorded them): f(x, y, z, axis).
 template <typename F>
-void for_each_owned_edge(const ValidCells& valid, F&& f) {
-  for (int z = 0; z < kBrickDim; ++z)
-    for (int y = 0; y < kBrickDim; ++y)
-      for (std::uint32_t bits = valid.owned_edges(y, z); bits != 0; bits &= bits - 1) {
-        const int k = std::countr_zero(bits);
-        f(k / 3, y, z, k % 3);
-      }
+void for_each_owned_edge(const SlotBits<kEdgeSlots>& owned, F&& f) {
+  for (int w = 0; w < SlotBits<kEdgeSlots>::kWords; ++w)
+    for (std::uint64_t bits = owned.words[std::size_t(w)]; bits != 0; bits &= bits - 1) {
+      const int slot = 64 * w + std::countr_zero(bits), n = slot / 3;
+      f(n & 7, (n >> 3) & 7, n >> 6, slot - 3 * n);
+    }
 }
 
 // The contoured cells of [0, 8)^3 that cross iso, in cell order: f(x, y, z, loops). The
@@ -176,7 +175,7 @@ void write_brick(const NarrowBand& band, const DecodedBand& decoded, std::uint32
   const Vec3d* const vertex_end = r.mesh.vertices.data() + at.vertex[b + 1];
   const std::array<std::uint32_t, 3>* const tri_end = r.mesh.triangles.data() + at.triangle[b + 1];
   auto differs = [] { return std::logic_error("marching_cubes: brick output differs from its count"); };
-  for_each_owned_edge(s.valid, [&](int x, int y, int z, int a) {
+  for_each_owned_edge(counts[b].owned, [&](int x, int y, int z, int a) {
     if (vertex == vertex_end) throw differs();
     const int p = CellTile::index(x, y, z);
     const double u = s.edges.at(p, a);
