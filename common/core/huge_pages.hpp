@@ -31,9 +31,11 @@ inline void advise_huge_pages(const void* data, std::size_t bytes) {
 }
 
 // Faults in the pages of [data, data + bytes) for writing, huge pages advised first where
-// whole 2 MiB pages fit, in one system call (MADV_POPULATE_WRITE, Linux 5.14+) instead of one
-// trap per 4 KiB page on first touch. On the virtual machines this runs on a trap costs
-// ~10 us: 4 MB sized by first touch 12 ms, advised and populated 3 ms; 48 MB 140 ms -> 7 ms.
+// whole 2 MiB pages fit: the 4 KiB pages outside them in one system call (MADV_POPULATE_WRITE,
+// Linux 5.14+) instead of one trap each on first touch; the whole huge pages are left to fault
+// in 2 MiB at a time on first write (populating them too made a fresh extraction's decode 12
+// ms instead of 4-9). On the virtual machines this runs on a trap costs ~10 us: 4 MB sized
+// by first touch 12 ms, advised and populated 3 ms; 48 MB 140 ms -> 7 ms.
 // Best effort (older kernels: advice only). Small ranges (< 256 KiB) are left alone.
 inline void prefault_for_write(const void* data, std::size_t bytes) {
   if (bytes < (std::size_t{256} << 10)) return;

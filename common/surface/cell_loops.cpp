@@ -166,16 +166,6 @@ const Table& table() {
 
 }  // namespace
 
-int unambiguous_triangles(int inside_mask) {
-  static const std::array<std::int8_t, 256> table = [] {
-    std::array<std::int8_t, 256> t{};
-    for (int m = 0; m < 256; ++m)
-      t[std::size_t(m)] = ambiguous_faces(m) != 0 ? std::int8_t(-1) : std::int8_t(loops_for(m, 0).fan_triangles);
-    return t;
-  }();
-  return table[std::size_t(inside_mask)];
-}
-
 const LoopSet& loops_for(int inside_mask, int face_decisions) { return table().lookup.at(inside_mask, face_decisions); }
 
 const LoopLookup& loop_lookup() { return table().lookup; }

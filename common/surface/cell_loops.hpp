@@ -74,10 +74,6 @@ struct LoopLookup {
 };
 const LoopLookup& loop_lookup();
 
-// The fan_triangles of loops_for(m, 0) when m has no face with 4 crossings (then its loops do
-// not depend on the face decisions, and it has no centre vertex); -1 when it has one.
-int unambiguous_triangles(int inside_mask);
-
 // Face corners of face f in the canonical order (0,0),(1,0),(1,1),(0,1) over the face's two
 // axes in increasing order.
 std::array<int, 4> face_corners(int f);
