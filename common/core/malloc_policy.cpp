@@ -1,5 +1,7 @@
 #include "core/malloc_policy.hpp"
 
+#include "core/huge_blocks.hpp"
+
 #include <cstdlib>
 #include <cstring>
 
@@ -14,7 +16,9 @@ bool keep_freed_memory(std::size_t keep_bytes) {
   if (off != nullptr && std::strcmp(off, "0") == 0) return false;
 #if defined(__GLIBC__)
   const int keep = keep_bytes > std::size_t(0x7fffffff) ? 0x7fffffff : int(keep_bytes);
-  return mallopt(M_MMAP_MAX, 0) == 1 && mallopt(M_TRIM_THRESHOLD, keep) == 1;
+  if (mallopt(M_MMAP_MAX, 0) != 1 || mallopt(M_TRIM_THRESHOLD, keep) != 1) return false;
+  enable_huge_blocks(keep_bytes);
+  return true;
 #else
   (void)keep_bytes;
   return false;
