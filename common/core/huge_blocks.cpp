@@ -15,7 +15,7 @@ constexpr std::size_t kHuge = kHugeBlockAlignment;
 // The largest request served (anything above is refused here and by malloc alike).
 constexpr std::size_t kMaxBytes = std::size_t{1} << 46;
 // Blocks tracked at once (live and cached); a full table sends requests to malloc.
-constexpr int kSlots = 512;
+constexpr int kSlots = 1024;
 
 struct Block {
   char* addr = nullptr;  // nullptr: free slot

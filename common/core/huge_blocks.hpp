@@ -1,15 +1,17 @@
-// Huge blocks: large buffers (at least kHugeBlockMinBytes) served from anonymous mappings of
-// their own, aligned to 2 MiB and sized in whole 2 MiB pages with transparent huge pages
-// advised, and kept for reuse when freed (up to a cache limit).
+// Huge blocks: large buffers (at least kHugeBlockMinBytes, 1 MiB) served from anonymous
+// mappings of their own, aligned to 2 MiB and sized in whole 2 MiB pages with transparent huge
+// pages advised, and kept for reuse when freed (up to a cache limit).
 //
 // Why: a fresh buffer is paid for page by page on first touch, and on the virtual machines this
-// runs on a 4 KiB fault costs ~10 us. A block inside glibc's heap starts and ends at arbitrary
-// addresses, so on average 1 MiB at each end lies outside any whole huge page and faults in 4
-// KiB at a time (or is populated so, which costs nearly as much): ~5 ms per buffer. A fresh
+// runs on a 4 KiB fault costs ~10 us (populating in one call, prefault_for_write, ~2-3 us a
+// page). A block inside glibc's heap starts and ends at arbitrary addresses, so on average 1 MiB
+// at each end lies outside any whole huge page and faults in 4 KiB at a time. A fresh
 // `levelsetd mesh` of knot.off at R = 256 (2 threads) spent 10-13 ms of its ~30 ms extraction
-// so. Aligned blocks fault in 2 MiB at a time. glibc's own aligned blocks (memalign) were tried:
+// so; armadillo's three 3.7 MB output arrays took 8-10 ms to size (0.8-1.3 ms as blocks here).
+// Aligned blocks fault in 2 MiB at a time. glibc's own aligned blocks (memalign) were tried:
 // they split the heap around them, and resident size grew 110 -> 282 MB over 20 extractions.
-// Blocks here never share a mapping with glibc's heap, so they cannot fragment it.
+// Blocks here never share a mapping with glibc's heap, so they cannot fragment it. Rounding to
+// 2 MiB costs at most 2 MiB of address space per block (and at most as much resident).
 //
 // Reuse: a request takes the smallest cached block that fits (splitting off the rest when the
 // block is at least twice the request); if none fits, the largest cached block grows by mremap
@@ -20,7 +22,8 @@
 // Used through operator new (core/huge_block_new.cpp, linked into levelsetd, the benches and the
 // unit tests) once enable_huge_blocks has been called (keep_freed_memory does). Linux only;
 // elsewhere allocate_huge_block returns nullptr and the caller uses malloc.
-// Threading: every function is thread-safe (one mutex; large allocations are rare).
+// Threading: every function is thread-safe (one mutex; large allocations are rare, and each
+// call scans a table of at most 1024 blocks).
 #pragma once
 
 #include <cstddef>
@@ -28,7 +31,7 @@
 
 namespace levelset {
 
-inline constexpr std::size_t kHugeBlockMinBytes = std::size_t{4} << 20;
+inline constexpr std::size_t kHugeBlockMinBytes = std::size_t{1} << 20;
 inline constexpr std::size_t kHugeBlockAlignment = std::size_t{2} << 20;
 
 // Turns the pool on; freed blocks are kept while they total at most cache_bytes.

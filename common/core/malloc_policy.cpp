@@ -17,7 +17,8 @@ bool keep_freed_memory(std::size_t keep_bytes) {
 #if defined(__GLIBC__)
   const int keep = keep_bytes > std::size_t(0x7fffffff) ? 0x7fffffff : int(keep_bytes);
   if (mallopt(M_MMAP_MAX, 0) != 1 || mallopt(M_TRIM_THRESHOLD, keep) != 1) return false;
-  enable_huge_blocks(keep_bytes);
+  const char* huge = std::getenv("LEVELSET_HUGE_BLOCKS");
+  if (huge == nullptr || std::strcmp(huge, "0") != 0) enable_huge_blocks(keep_bytes);
   return true;
 #else
   (void)keep_bytes;

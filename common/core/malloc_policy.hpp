@@ -14,8 +14,10 @@
 // freed one is reused by the next request) and a trim threshold of `keep_bytes`, the free memory
 // at the main heap's top that is kept. Peak resident size: knot.off R = 512 extractions 142 ->
 // 165 MB, a 20k-point reconstruction at R = 512 351 -> 323 MB.
-// The environment variable LEVELSET_KEEP_FREED_MEMORY=0 leaves glibc's defaults (a machine
-// short of memory; A/B measurements).
+// Blocks of 1 MiB and more go to the huge block pool (core/huge_blocks.hpp) in programs that
+// link its operator new: 2 MiB-aligned mappings of their own, kept for reuse up to `keep_bytes`.
+// The environment variable LEVELSET_KEEP_FREED_MEMORY=0 leaves glibc's defaults and no pool (a
+// machine short of memory; A/B measurements); LEVELSET_HUGE_BLOCKS=0 leaves only the pool off.
 // Returns whether the allocator took the settings (false where malloc is not glibc's, or
 // left by the variable).
 // Threading: call once at the start of main, before threads allocate.
