@@ -19,6 +19,7 @@
 #include "evolve/axis_lines.hpp"
 #include "evolve/curvature.hpp"
 #include "evolve/curvature_batch.hpp"
+#include "evolve/gradient_batch.hpp"
 #include "grid/band_accessor.hpp"
 #include "grid/interpolate.hpp"
 #include "grid/tile.hpp"
@@ -40,6 +41,7 @@ struct Scratch {
   std::array<float, kBrickVoxels> d, x, y, z, nx, ny, nz, mean, gauss, k1, k2, grad, beta_a, beta_p;
   std::array<float, kBrickVoxels> dist, dgx, dgy, dgz, dn, img, edge, roi;
   std::array<std::array<OneSided, 3>, kBrickVoxels> os;
+  std::array<double, kBrickVoxels> gnorm;  // |grad u| by central differences, by brick voxel index
   std::unique_ptr<AxisLines> lines;
   std::unique_ptr<UpwindSides> sides;
   std::array<Vec3d, kBrickVoxels> vel;
@@ -313,6 +315,9 @@ int voxel_pass(const NarrowBand& band, const Neighborhood& around, std::uint32_t
                              ~unsigned(s.interior[std::size_t(r)]) & 0xffu);
     out.edge_stencils[b].reserve(std::size_t(edges));
   }
+  // |grad u| for the whole brick at once (vector code); the loop below reads it by voxel.
+  if (parabolic || setup.want_stats || (needs & (kNeedsNormal | kNeedsGradNorm)))
+    central_gradient_norms(s.tile.data() + tile_index(0, 0, 0), kStride[1], kStride[2], h, s.gnorm.data());
   int k = 0;
   br.active.for_each_set([&](int n) {
     const Coord l = local_coord(n);
@@ -356,16 +361,14 @@ int voxel_pass(const NarrowBand& band, const Neighborhood& around, std::uint32_t
     // Central gradient: for the parabolic part, normals, |grad u| and the drift near the front.
     const bool near = setup.want_stats && std::abs(*v) < 2 * h;
     const bool want_grad = parabolic || near || (needs & (kNeedsNormal | kNeedsGradNorm));
-    Vec3d g{};
-    if (want_grad)
-      g = Vec3d{double(v[1]) - double(v[-1]), double(v[kDim]) - double(v[-kDim]),
-                double(v[kDim * kDim]) - double(v[-kDim * kDim])} * (0.5 / h);
-    const double gn = want_grad ? length(g) : 0.0;
+    const double gn = want_grad ? s.gnorm[std::size_t(n)] : 0.0;
     if (needs & (kNeedsMean | kNeedsPrincipal | kNeedsGauss))
       s.curvature_at_tile[std::size_t(k)] =
           (s.whole[std::size_t(l.y + kBrickDim * l.z)] >> l.x) & 1u ? tile_index(l.x, l.y, l.z) : curvature_source(s, l);
     s.grad[std::size_t(k)] = float(gn);
     if (needs & kNeedsNormal) {
+      const Vec3d g = Vec3d{double(v[1]) - double(v[-1]), double(v[kDim]) - double(v[-kDim]),
+                            double(v[kDim * kDim]) - double(v[-kDim * kDim])} * (0.5 / h);
       const Vec3d nrm = gn > 0 ? g / gn : Vec3d{};
       s.nx[std::size_t(k)] = float(nrm.x);
       s.ny[std::size_t(k)] = float(nrm.y);
