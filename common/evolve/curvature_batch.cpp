@@ -21,8 +21,10 @@ std::array<std::ptrdiff_t, kSamples> sample_offsets(const std::ptrdiff_t stride[
           -sx - sy, sx + sz, sx - sz, -sx + sz, -sx - sz, sy + sz, sy - sz, -sy + sz, -sy - sz};
 }
 
-// Eight consecutive centres: s[k][x] holds sample k of centre x.
-void row_curvature(const double (&s)[kSamples][kBrickDim], double h, double (&mean)[kBrickDim],
+// Eight consecutive centres: s[k][x] holds sample k of centre x. Always inlined: a callee of
+// a target_clones function is otherwise compiled once, for the default instruction set (the
+// clones then ran 1.5x slower than the plain function).
+[[gnu::always_inline]] inline void row_curvature(const double (&s)[kSamples][kBrickDim], double h, double (&mean)[kBrickDim],
                    double (&gauss)[kBrickDim]) {
   const double inv2h = 0.5 / h, invh2 = 1.0 / (h * h), inv4h2 = 0.25 * invh2;
   for (int i = 0; i < kBrickDim; ++i) {
@@ -50,6 +52,12 @@ void row_curvature(const double (&s)[kSamples][kBrickDim], double h, double (&me
 
 }  // namespace
 
+// Built for three instruction sets, picked when the program loads (the same IEEE operations
+// in the same order, without contraction: the results do not depend on which). A brick of
+// full rows: 8.3 -> 4.9 ns per voxel (AVX-512).
+#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__)
+__attribute__((target_clones("avx512f", "avx2", "default")))
+#endif
 void mean_gauss_curvature_brick(const float* tile, std::ptrdiff_t origin, const std::ptrdiff_t stride[3],
                                 const BrickMask& active, const int* at, double h, float* mean, float* gauss) {
   if (stride[0] != 1) throw Error(ErrorCode::InvalidArgument, "mean_gauss_curvature_brick", "x must be the tile's fastest axis");
