@@ -216,6 +216,7 @@ void brick_rates(const Scratch& s, const EvolutionOptions& o, int count, double 
   const bool advective = moving && o.speed.has_advective, parabolic = moving && o.speed.has_parabolic;
   const bool upwind = advective || velocity;
   const bool llf = o.hamiltonian == Hamiltonian::LaxFriedrichs;
+  double max_hyp = stats.max_hyp, max_speed = stats.max_speed, max_front = stats.max_front;  // in registers
   for (int i = 0; i < count; ++i) {
     const std::size_t u = std::size_t(i);
     const double ba = advective ? double(s.beta_a[u]) : 0.0;
@@ -237,13 +238,16 @@ void brick_rates(const Scratch& s, const EvolutionOptions& o, int count, double 
     if (parabolic) rate -= bp * double(s.grad[u]);
     rate_out[u] = float(rate);
     const double vsum = std::abs(vel.x) + std::abs(vel.y) + std::abs(vel.z);
-    stats.max_hyp = std::max(stats.max_hyp, kSqrt3 * std::abs(ba) + vsum);
+    max_hyp = std::max(max_hyp, kSqrt3 * std::abs(ba) + vsum);
     const double sp = std::abs(ba) + std::abs(bp) + (velocity ? length(vel) : 0.0);
-    stats.max_speed = std::max(stats.max_speed, sp);
+    max_speed = std::max(max_speed, sp);
     // The front's speed: voxels next to the zero level only (curvatures blow up near the
     // skeleton, deep in the band, without the front moving).
-    if (std::abs(s.d[u]) < 1.5 * h) stats.max_front = std::max(stats.max_front, sp);
+    if (std::abs(s.d[u]) < 1.5 * h) max_front = std::max(max_front, sp);
   }
+  stats.max_hyp = max_hyp;
+  stats.max_speed = max_speed;
+  stats.max_front = max_front;
 }
 
 // Pure advection by a constant velocity: brick_rates' arithmetic (upwind_advection, in the same
@@ -318,6 +322,11 @@ int voxel_pass(const NarrowBand& band, const Neighborhood& around, std::uint32_t
   // |grad u| for the whole brick at once (vector code); the loop below reads it by voxel.
   if (parabolic || setup.want_stats || (needs & (kNeedsNormal | kNeedsGradNorm)))
     central_gradient_norms(s.tile.data() + tile_index(0, 0, 0), kStride[1], kStride[2], h, s.gnorm.data());
+  // The reductions in locals (kept in registers; stats' fields would be stored and reloaded
+  // per voxel), combined in the same order, so the sums are unchanged.
+  double drift_sum = stats.drift_sum;
+  std::uint64_t drift_count = stats.drift_count, crossings = stats.crossings;
+  float min_value = stats.min_value, max_value = stats.max_value;
   int k = 0;
   br.active.for_each_set([&](int n) {
     const Coord l = local_coord(n);
@@ -378,13 +387,13 @@ int voxel_pass(const NarrowBand& band, const Neighborhood& around, std::uint32_t
                                      double(s.dgz[std::size_t(k)]) * nrm.z);
     }
     if (near) {
-      stats.drift_sum += std::abs(gn - 1.0);
-      ++stats.drift_count;
+      drift_sum += std::abs(gn - 1.0);
+      ++drift_count;
     }
-    stats.min_value = std::min(stats.min_value, *v);
-    stats.max_value = std::max(stats.max_value, *v);
+    min_value = std::min(min_value, *v);
+    max_value = std::max(max_value, *v);
     if (setup.want_edges)
-      stats.crossings += unsigned((v[0] < 0.0f) != (v[1] < 0.0f)) + unsigned((v[0] < 0.0f) != (v[kDim] < 0.0f)) +
+      crossings += unsigned((v[0] < 0.0f) != (v[1] < 0.0f)) + unsigned((v[0] < 0.0f) != (v[kDim] < 0.0f)) +
                          unsigned((v[0] < 0.0f) != (v[kDim * kDim] < 0.0f));
     if (setup.want_edges && !((s.interior[std::size_t(l.y + kBrickDim * l.z)] >> l.x) & 1u)) {
       out.edge[first + std::size_t(k)] = 1;
@@ -396,6 +405,11 @@ int voxel_pass(const NarrowBand& band, const Neighborhood& around, std::uint32_t
     }
     ++k;
   });
+  stats.drift_sum = drift_sum;
+  stats.drift_count = drift_count;
+  stats.crossings = crossings;
+  stats.min_value = min_value;
+  stats.max_value = max_value;
   return k;
 }
 
