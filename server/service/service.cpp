@@ -4,6 +4,7 @@
 
 #include "core/error.hpp"
 #include "core/file_io.hpp"
+#include "core/huge_blocks.hpp"
 #include "grid/lsg_file.hpp"
 #include "service/api_error.hpp"
 #include "service/ids.hpp"
@@ -131,6 +132,17 @@ std::string Service::metrics() const {
   metric("levelset_jobs_failed_total", "counter", "Jobs that failed", double(jobs_failed_.load()));
   metric("levelset_streams_open", "gauge", "Open event streams", double(streams_open.load()));
   metric("levelset_uploads_bytes", "gauge", "Bytes held by uploads", double(uploads_->total_bytes()));
+  // The large buffers' pool (core/huge_blocks.hpp): what computations hold, and what freed
+  // buffers keep for the next request (at most the keep_freed_memory limit).
+  const HugeBlockStats blocks = huge_block_stats();
+  metric("levelset_huge_blocks_live_bytes", "gauge", "Bytes of large buffers (1 MiB and more) in use",
+         double(blocks.live_bytes));
+  metric("levelset_huge_blocks_cached_bytes", "gauge", "Bytes of freed large buffers kept for reuse",
+         double(blocks.cached_bytes));
+  metric("levelset_huge_blocks_mapped_total", "counter", "Large buffers mapped afresh (not reused)",
+         double(blocks.mapped));
+  metric("levelset_huge_blocks_reused_total", "counter", "Large buffers served from the kept ones",
+         double(blocks.reused + blocks.grown));
   return out;
 }
 

@@ -80,6 +80,19 @@ def test_surface():
         check(d.get("/readyz")[0] == 200, "readyz")
         status, hdrs, metrics = d.request("GET", "/metrics")
         check(status == 200 and b"# TYPE levelset_requests_total counter" in metrics, "metrics")
+        # Large buffers come from the huge block pool (levelsetd links its operator new): a
+        # session whose band takes several MB maps some.
+        status, _, made = d.post("/api/v1/sessions", {"primitive": "sphere", "raster": {"resolution": 192}})
+        check(status in (200, 201), f"a 192^3 sphere: {made}")
+        metrics = d.request("GET", "/metrics")[2].decode()
+        values = {line.split()[0]: float(line.split()[1]) for line in metrics.splitlines()
+                  if line.startswith("levelset_huge_blocks_")}
+        check(set(values) == {"levelset_huge_blocks_live_bytes", "levelset_huge_blocks_cached_bytes",
+                              "levelset_huge_blocks_mapped_total", "levelset_huge_blocks_reused_total"},
+              f"huge block metrics: {values}")
+        check(values["levelset_huge_blocks_mapped_total"] > 0 and values["levelset_huge_blocks_live_bytes"] > 0,
+              f"the daemon's large buffers come from the pool: {values}")
+        d.request("DELETE", f"/api/v1/sessions/{made['id']}")
         status, hdrs, _ = d.request("GET", "/healthz")
         check(len(hdrs.get("X-Request-Id", "")) > 0, "X-Request-Id")
         status, hdrs, _ = d.request("GET", "/healthz", headers={"X-Request-Id": "my-request-1"})
