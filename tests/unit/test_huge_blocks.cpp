@@ -5,7 +5,9 @@
 #include <atomic>
 #include <cstdint>
 #include <cstring>
+#include <map>
 #include <memory>
+#include <random>
 #include <thread>
 #include <vector>
 
@@ -156,6 +158,75 @@ TEST(HugeBlocks, ThreadsAllocatingAndFreeingAtOnceKeepTheBooks) {
   EXPECT_LE(after.cached_bytes, 256 * kMiB);
   // Most requests were served from the cache: at most one mapping per thread and size.
   EXPECT_LT(after.mapped - before.mapped, 4u * 11u);
+}
+
+// A random sequence of requests and releases (sizes 1-40 MiB, so every path runs: fresh
+// mappings, reuse, splits, growth, eviction) against a model: live blocks never overlap, each
+// keeps what was written to it until released, and the books add up.
+TEST(HugeBlocks, RandomRequestsAndReleasesKeepBlocksApartAndIntact) {
+  reset_pool(48 * kMiB);
+  const HugeBlockStats start = huge_block_stats();
+  std::mt19937 rng(20261128);
+  struct Live {
+    std::size_t bytes;
+    unsigned char mark;
+  };
+  std::map<unsigned char*, Live> live;  // by address, for the overlap check
+  auto intact = [](unsigned char* p, const Live& l) {
+    // First and last byte of every 4 KiB page (touching each page once).
+    for (std::size_t i = 0; i < l.bytes; i += 4096)
+      if (p[i] != l.mark || p[std::min(i + 4095, l.bytes - 1)] != l.mark) return false;
+    return true;
+  };
+  std::size_t live_rounded = 0;
+  bool ok = true;
+  for (int step = 0; step < 600 && ok; ++step) {
+    const bool release = !live.empty() && (live.size() >= 6 || rng() % 2 == 0);
+    if (release) {
+      auto it = std::next(live.begin(), std::ptrdiff_t(rng() % live.size()));
+      ok &= intact(it->first, it->second);
+      live_rounded -= (it->second.bytes + kHugeBlockAlignment - 1) / kHugeBlockAlignment * kHugeBlockAlignment;
+      ok &= release_huge_block(it->first);
+      live.erase(it);
+    } else {
+      const std::size_t bytes = kMiB + std::size_t(rng() % (39 * kMiB));
+      auto* p = static_cast<unsigned char*>(allocate_huge_block(bytes));
+      ok &= p != nullptr && aligned(p);
+      if (p == nullptr) break;
+      const auto mark = static_cast<unsigned char>(step);
+      for (std::size_t i = 0; i < bytes; i += 4096) {
+        p[i] = mark;
+        p[std::min(i + 4095, bytes - 1)] = mark;
+      }
+      // No overlap with the neighbours in address order.
+      auto next = live.lower_bound(p);
+      if (next != live.end()) ok &= p + bytes <= next->first;
+      if (next != live.begin()) {
+        auto prev = std::prev(next);
+        ok &= prev->first + prev->second.bytes <= p;
+      }
+      live.emplace(p, Live{bytes, mark});
+      live_rounded += (bytes + kHugeBlockAlignment - 1) / kHugeBlockAlignment * kHugeBlockAlignment;
+    }
+    const HugeBlockStats now = huge_block_stats();
+    ok &= now.live_blocks == start.live_blocks + live.size();
+    // At least the rounded requests (a reused block smaller than twice a request serves it
+    // whole), and all of it mapped or cached within the limit.
+    ok &= now.live_bytes >= start.live_bytes + live_rounded;
+    ok &= now.cached_bytes <= 48 * kMiB;
+    EXPECT_TRUE(ok) << "step " << step;
+  }
+  for (auto& [p, l] : live) {
+    EXPECT_TRUE(intact(p, l));
+    EXPECT_TRUE(release_huge_block(p));
+  }
+  const HugeBlockStats end = huge_block_stats();
+  EXPECT_EQ(end.live_bytes, start.live_bytes);
+  EXPECT_EQ(end.live_blocks, start.live_blocks);
+  // Every path ran.
+  EXPECT_GT(end.reused, start.reused);
+  EXPECT_GT(end.grown, start.grown);
+  EXPECT_GT(end.unmapped, start.unmapped);
 }
 
 #if !defined(__SANITIZE_ADDRESS__)
