@@ -9,13 +9,15 @@
 //   there is about one triangle per surface voxel as in scans and meshes extracted from grids:
 //   a marching-cubes sphere at R = 256 (588k triangles) and every CGAL mesh subdivided until
 //   it has as many triangles as surface voxels at R = 128, each for W = 3, 6, 12.
-// Usage: bench_cpt [--quick] [--dense-only]  (--quick: knot.off at R = 64 only, for ctest)
+// Usage: bench_cpt [--quick] [--dense-only] [--meshes A.off,B.off,...]
+//   (--quick: knot.off at R = 64 only, for ctest; --meshes: only these CGAL meshes' dense rows)
 // Exit code 1 if a mesh is missing in the full run or the two sides disagree grossly on the
 // band (active voxel counts more than 5% apart: OpenVDB's band is not exact, ours is).
 #include <cmath>
 #include <cstdio>
 #include <algorithm>
 #include <filesystem>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -116,7 +118,16 @@ bool bench_dense(const std::string& name, const TriangleMesh& coarse, int resolu
 int main(int argc, char** argv) {
   const bool quick = bench::is_quick(argc, argv);
   bool dense_only = false;
-  for (int i = 1; i < argc; ++i) dense_only |= std::string(argv[i]) == "--dense-only";
+  std::vector<std::string> only;  // --meshes: the dense rows of these files only
+  for (int i = 1; i < argc; ++i) {
+    const std::string arg = argv[i];
+    dense_only |= arg == "--dense-only";
+    if (arg == "--meshes" && i + 1 < argc) {
+      dense_only = true;
+      std::stringstream list(argv[++i]);
+      for (std::string name; std::getline(list, name, ',');) only.push_back(name);
+    }
+  }
   openvdb::initialize();
   const std::string data = std::string(LEVELSET_CGAL_DATA) + "/meshes/";
   std::printf("bench_cpt: closest point transform vs OpenVDB %s meshToLevelSet\n",
@@ -147,11 +158,12 @@ int main(int argc, char** argv) {
           for (int threads : {1, 2}) ok &= bench_row({name, &mesh, &vdb, res, 3.0, threads, 3, "coarse", true}, summary);
         for (double w : {6.0, 12.0}) ok &= bench_row({name, &mesh, &vdb, 256, w, 2, 3, "coarse", true}, summary);
       }
-    ok &= bench_dense("sphere (marching cubes)", marching_cubes_sphere(256), 256, true, summary);
+    if (only.empty()) ok &= bench_dense("sphere (marching cubes)", marching_cubes_sphere(256), 256, true, summary);
     std::vector<std::filesystem::path> files;
     for (const auto& entry : std::filesystem::directory_iterator(data)) files.push_back(entry.path());
     std::sort(files.begin(), files.end());
     for (const auto& path : files) {
+      if (!only.empty() && std::find(only.begin(), only.end(), path.filename().string()) == only.end()) continue;
       TriangleMesh mesh;
       try {
         mesh = read_mesh(path.string()).mesh;
