@@ -20,8 +20,6 @@
 #include "evolve/curvature.hpp"
 #include "evolve/curvature_batch.hpp"
 #include "evolve/gradient_batch.hpp"
-#include "grid/band_accessor.hpp"
-#include "grid/interpolate.hpp"
 #include "grid/tile.hpp"
 
 namespace levelset::evolve::detail {
@@ -300,6 +298,48 @@ struct OperatorPlan {
 // The per-voxel pass over one brick's active voxels (k-th in ascending local index): values,
 // speed inputs (positions, fields, normals, |grad u|, where each curvature comes from),
 // velocities, one-sided derivatives, drift, edges and their stencils. Returns the count.
+// The brick's active voxels with an inactive face neighbour (Scratch::interior).
+std::size_t edge_voxel_count(const Brick& br, const Scratch& s) {
+  int edges = 0;
+  for (int r = 0; r < kBrickDim * kBrickDim; ++r)
+    edges += std::popcount(unsigned(std::uint8_t(br.active.words[std::size_t(r >> 3)] >> (8 * (r & 7)))) &
+                           ~unsigned(s.interior[std::size_t(r)]) & 0xffu);
+  return std::size_t(edges);
+}
+
+// The k-th voxel's position and the fields its speed reads, at world point `world` (returned).
+Vec3d sample_fields(const Vec3d& world, const SpeedFields& f, std::uint32_t needs, int k, Scratch& s) {
+  const std::size_t u = std::size_t(k);
+  s.x[u] = float(world.x);
+  s.y[u] = float(world.y);
+  s.z[u] = float(world.z);
+  if (needs & kNeedsDist) s.dist[u] = float(f.dist(world));
+  if (needs & kNeedsDistGradient) {
+    const Vec3d g = f.dist_gradient(world);
+    s.dgx[u] = float(g.x);
+    s.dgy[u] = float(g.y);
+    s.dgz[u] = float(g.z);
+  }
+  if (needs & kNeedsImage) s.img[u] = float(f.image(world));
+  if (needs & kNeedsEdge) s.edge[u] = float(f.edge(world));
+  if (needs & kNeedsRoi) s.roi[u] = float(f.roi(world));
+  return world;
+}
+
+// The k-th voxel's one-sided derivatives from the brick's batch (UpwindSides).
+void voxel_one_sided(int k, bool advection_only, Scratch& s) {
+  auto& d = s.os[std::size_t(k)];
+  for (int a = 0; a < 3; ++a) d[std::size_t(a)] = s.sides->at(a, k);
+  if (advection_only) {
+    // Pure advection upwinds each axis by the velocity's sign: the other side reads 0.
+    const Vec3d& vel = s.vel[std::size_t(k)];
+    for (int a = 0; a < 3; ++a) {
+      if (!(vel[a] > 0.0)) d[std::size_t(a)].minus = 0.0;
+      if (!(vel[a] < 0.0)) d[std::size_t(a)].plus = 0.0;
+    }
+  }
+}
+
 int voxel_pass(const NarrowBand& band, const Neighborhood& around, std::uint32_t b, const OperatorSetup& setup,
                const OperatorPlan& plan, Scratch& s, OperatorOutput& out, OperatorStats& stats) {
   const EvolutionOptions& o = setup.options;
@@ -313,11 +353,7 @@ int voxel_pass(const NarrowBand& band, const Neighborhood& around, std::uint32_t
   if (setup.want_edges) {
     edge_rows(band, around, s);
     // One allocation for the brick's edge stencils (at most one per edge voxel).
-    int edges = 0;
-    for (int r = 0; r < kBrickDim * kBrickDim; ++r)
-      edges += std::popcount(unsigned(std::uint8_t(br.active.words[std::size_t(r >> 3)] >> (8 * (r & 7)))) &
-                             ~unsigned(s.interior[std::size_t(r)]) & 0xffu);
-    out.edge_stencils[b].reserve(std::size_t(edges));
+    out.edge_stencils[b].reserve(edge_voxel_count(br, s));
   }
   // |grad u| for the whole brick at once (vector code); the loop below reads it by voxel.
   if (parabolic || setup.want_stats || (needs & (kNeedsNormal | kNeedsGradNorm)))
@@ -332,41 +368,14 @@ int voxel_pass(const NarrowBand& band, const Neighborhood& around, std::uint32_t
     const Coord l = local_coord(n);
     const float* v = s.tile.data() + tile_index(l.x, l.y, l.z);
     s.d[std::size_t(k)] = *v;
-    Vec3d world{};
     constexpr std::uint32_t kFieldNeeds = kNeedsDist | kNeedsDistGradient | kNeedsImage | kNeedsEdge | kNeedsRoi;
-    if ((needs & (kNeedsPosition | kFieldNeeds)) || (velocity && o.velocity.kind == Velocity::Kind::Field)) {
-      world = band.world(origin + l);
-      s.x[std::size_t(k)] = float(world.x);
-      s.y[std::size_t(k)] = float(world.y);
-      s.z[std::size_t(k)] = float(world.z);
-      const SpeedFields& f = o.fields;
-      const std::size_t u = std::size_t(k);
-      if (needs & kNeedsDist) s.dist[u] = float(f.dist(world));
-      if (needs & kNeedsDistGradient) {
-        const Vec3d g = f.dist_gradient(world);
-        s.dgx[u] = float(g.x);
-        s.dgy[u] = float(g.y);
-        s.dgz[u] = float(g.z);
-      }
-      if (needs & kNeedsImage) s.img[u] = float(f.image(world));
-      if (needs & kNeedsEdge) s.edge[u] = float(f.edge(world));
-      if (needs & kNeedsRoi) s.roi[u] = float(f.roi(world));
-    }
+    const Vec3d world = (needs & (kNeedsPosition | kFieldNeeds)) || (velocity && o.velocity.kind == Velocity::Kind::Field)
+                            ? sample_fields(band.world(origin + l), o.fields, needs, k, s)
+                            : Vec3d{};
     if (velocity && !constant_advection)
       s.vel[std::size_t(k)] = o.velocity.kind == Velocity::Kind::Constant ? o.velocity.constant
                                                                           : o.velocity.field(world, setup.time);
-    if (upwind && !constant_advection) {
-      auto& d = s.os[std::size_t(k)];
-      for (int a = 0; a < 3; ++a) d[std::size_t(a)] = s.sides->at(a, k);
-      if (advection_only) {
-        // Pure advection upwinds each axis by the velocity's sign: the other side reads 0.
-        const Vec3d& vel = s.vel[std::size_t(k)];
-        for (int a = 0; a < 3; ++a) {
-          if (!(vel[a] > 0.0)) d[std::size_t(a)].minus = 0.0;
-          if (!(vel[a] < 0.0)) d[std::size_t(a)].plus = 0.0;
-        }
-      }
-    }
+    if (upwind && !constant_advection) voxel_one_sided(k, advection_only, s);
     // Central gradient: for the parabolic part, normals, |grad u| and the drift near the front.
     const bool near = setup.want_stats && std::abs(*v) < 2 * h;
     const bool want_grad = parabolic || near || (needs & (kNeedsNormal | kNeedsGradNorm));
@@ -521,43 +530,6 @@ void brick_operator(const NarrowBand& band, std::span<const float> decoded, std:
 
 }  // namespace
 
-// Area-weighted mean of H over the zero level: sum of H delta(u) |grad u| / sum of
-// delta(u) |grad u| over the band, with the smeared delta of width 1.5 h.
-double mean_curvature_average(const NarrowBand& band) {
-  const double h = band.voxel_size(), eps = 1.5 * h;
-  struct Acc {
-    double num = 0, den = 0;
-  };
-  tbb::combinable<Acc> acc;
-  tbb::enumerable_thread_specific<Scratch> scratch;
-  tbb::parallel_for(tbb::blocked_range<std::uint32_t>(0, std::uint32_t(band.brick_count()), 16),
-                    [&](const tbb::blocked_range<std::uint32_t>& r) {
-    Scratch& s = scratch.local();
-    Acc& a = acc.local();
-    for (std::uint32_t b = r.begin(); b != r.end(); ++b) {
-      const Brick& br = band.bricks()[b];
-      const float* vals = band.values().data() + br.value_offset;
-      bool any = false;
-      for (int i = 0; i < br.active_count() && !any; ++i) any = std::abs(double(vals[i])) < eps;
-      if (!any) continue;
-      gather_box(band, b, kLo, kHi, s.tile, {});
-      br.active.for_each_set([&](int n) {
-        const Coord l = local_coord(n);
-        const float* v = s.tile.data() + tile_index(l.x, l.y, l.z);
-        const double u = *v;
-        if (std::abs(u) >= eps) return;
-        const Vec3d g{(double(v[1]) - double(v[-1])) / (2 * h), (double(v[kDim]) - double(v[-kDim])) / (2 * h),
-                      (double(v[kDim * kDim]) - double(v[-kDim * kDim])) / (2 * h)};
-        const double w = (1.0 + std::cos(3.141592653589793 * u / eps)) / (2 * eps) * length(g);
-        a.num += w * mean_curvature_at(v, kStride, h);
-        a.den += w;
-      });
-    }
-  });
-  const Acc total = acc.combine([](const Acc& x, const Acc& y) { return Acc{x.num + y.num, x.den + y.den}; });
-  return total.den > 0 ? total.num / total.den : 0.0;
-}
-
 OperatorOutput run_operator(const NarrowBand& band, const OperatorSetup& setup) {
   OperatorOutput out;
   out.min_value = std::numeric_limits<float>::infinity();
@@ -598,43 +570,6 @@ OperatorOutput run_operator(const NarrowBand& band, const OperatorSetup& setup) 
     out.max_value = std::max(out.max_value, st.max_value);
   });
   return out;
-}
-
-// Speeds extended from the zero level: each voxel takes the speeds at its closest point
-// x - u n (trilinear in the band's speeds; all 8 corners there are active for W >= 2).
-void extend_speeds(const NarrowBand& band, std::vector<float>& beta_a, std::vector<float>& beta_p) {
-  NarrowBand field_a = band, field_p = band;
-  std::vector<float> a = beta_a, p = beta_p;
-  field_a.swap_values(a);
-  field_p.swap_values(p);
-  const double h = band.voxel_size();
-  std::vector<float> ext_a(beta_a.size()), ext_p(beta_p.size());
-  tbb::enumerable_thread_specific<Scratch> scratch;
-  tbb::parallel_for(tbb::blocked_range<std::uint32_t>(0, std::uint32_t(band.brick_count()), 8),
-                    [&](const tbb::blocked_range<std::uint32_t>& r) {
-    Scratch& s = scratch.local();
-    BandAccessor acc_a(field_a), acc_p(field_p);
-    for (std::uint32_t b = r.begin(); b != r.end(); ++b) {
-      gather_box(band, b, kLo, kHi, s.tile, {});
-      const Brick& br = band.bricks()[b];
-      const Coord origin = brick_origin(br.coord);
-      std::size_t k = br.value_offset;
-      br.active.for_each_set([&](int n) {
-        const Coord l = local_coord(n);
-        const float* v = s.tile.data() + tile_index(l.x, l.y, l.z);
-        const Vec3d g{(double(v[1]) - double(v[-1])) / (2 * h), (double(v[kDim]) - double(v[-kDim])) / (2 * h),
-                      (double(v[kDim * kDim]) - double(v[-kDim * kDim])) / (2 * h)};
-        const double gn = length(g);
-        const Vec3d x = band.world(origin + l);
-        const Vec3d c = gn > 1e-12 ? x - g * (double(*v) / (gn * gn)) : x;
-        ext_a[k] = sample_trilinear(acc_a, field_a, c);
-        ext_p[k] = sample_trilinear(acc_p, field_p, c);
-        ++k;
-      });
-    }
-  });
-  beta_a.swap(ext_a);
-  beta_p.swap(ext_p);
 }
 
 }  // namespace levelset::evolve::detail

@@ -13,6 +13,7 @@
 // mean_curvature_average(band): the area-weighted mean of H over the zero level (kavg).
 // extend_speeds(band, beta_a, beta_p): the speeds extended from the zero level (each voxel
 //   takes them at its closest point); both vectors in band value order, replaced.
+//   These two live in front_fields.cpp.
 // Internal to levelset_core (namespace evolve::detail).
 #pragma once
 
