@@ -38,6 +38,8 @@ namespace levelset::evolve::detail {
 
 inline constexpr int kLo = -kStencilReach, kHi = kBrickDim + kStencilReach, kDim = kHi - kLo;
 constexpr int tile_index(int x, int y, int z) { return (x - kLo) + kDim * ((y - kLo) + kDim * (z - kLo)); }
+// The tile's strides along x, y and z (tile_index).
+inline constexpr std::ptrdiff_t kTileStride[3] = {1, kDim, kDim * kDim};
 
 struct AxisLines {
   static constexpr int kLen = kDim;

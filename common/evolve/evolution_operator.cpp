@@ -29,7 +29,6 @@ namespace {
 using Clock = std::chrono::steady_clock;
 double since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
 
-constexpr std::ptrdiff_t kStride[3] = {1, kDim, kDim * kDim};
 constexpr double kSqrt3 = 1.7320508075688772;
 
 // Per-thread buffers for one brick (at most 512 active voxels).
@@ -357,7 +356,7 @@ int voxel_pass(const NarrowBand& band, const Neighborhood& around, std::uint32_t
   }
   // |grad u| for the whole brick at once (vector code); the loop below reads it by voxel.
   if (parabolic || setup.want_stats || (needs & (kNeedsNormal | kNeedsGradNorm)))
-    central_gradient_norms(s.tile.data() + tile_index(0, 0, 0), kStride[1], kStride[2], h, s.gnorm.data());
+    central_gradient_norms(s.tile.data() + tile_index(0, 0, 0), kTileStride[1], kTileStride[2], h, s.gnorm.data());
   // The reductions in locals (kept in registers; stats' fields would be stored and reloaded
   // per voxel), combined in the same order, so the sums are unchanged.
   double drift_sum = stats.drift_sum;
@@ -427,14 +426,14 @@ void brick_curvatures(const Brick& br, std::uint32_t needs, int count, double h,
   if (needs & kNeedsPrincipal) {
     for (int i = 0; i < count; ++i) {
       const int at = s.curvature_at_tile[std::size_t(i)];
-      const Curvature c = at >= 0 ? curvature_at(s.tile.data() + at, kStride, h) : Curvature{};
+      const Curvature c = at >= 0 ? curvature_at(s.tile.data() + at, kTileStride, h) : Curvature{};
       s.mean[std::size_t(i)] = float(c.mean);
       s.gauss[std::size_t(i)] = float(c.gauss);
       s.k1[std::size_t(i)] = float(c.k1);
       s.k2[std::size_t(i)] = float(c.k2);
     }
   } else if (needs & (kNeedsGauss | kNeedsMean)) {
-    mean_gauss_curvature_brick(s.tile.data(), tile_index(0, 0, 0), kStride, br.active, s.curvature_at_tile.data(), h,
+    mean_gauss_curvature_brick(s.tile.data(), tile_index(0, 0, 0), kTileStride, br.active, s.curvature_at_tile.data(), h,
                                s.mean.data(), s.gauss.data());
   }
 }

@@ -17,10 +17,6 @@
 
 namespace levelset::evolve::detail {
 
-namespace {
-constexpr std::ptrdiff_t kStride[3] = {1, kDim, kDim * kDim};
-}  // namespace
-
 // Area-weighted mean of H over the zero level: sum of H delta(u) |grad u| / sum of
 // delta(u) |grad u| over the band, with the smeared delta of width 1.5 h.
 double mean_curvature_average(const NarrowBand& band) {
@@ -49,7 +45,7 @@ double mean_curvature_average(const NarrowBand& band) {
         const Vec3d g{(double(v[1]) - double(v[-1])) / (2 * h), (double(v[kDim]) - double(v[-kDim])) / (2 * h),
                       (double(v[kDim * kDim]) - double(v[-kDim * kDim])) / (2 * h)};
         const double w = (1.0 + std::cos(3.141592653589793 * u / eps)) / (2 * eps) * length(g);
-        a.num += w * mean_curvature_at(v, kStride, h);
+        a.num += w * mean_curvature_at(v, kTileStride, h);
         a.den += w;
       });
     }

@@ -173,6 +173,11 @@ int main(int argc, char** argv) {
       if (mesh.triangles.empty()) continue;
       ok &= bench_dense(path.filename().string(), mesh, 128, false, summary);
     }
+    for (const std::string& name : only)
+      if (!std::filesystem::exists(data + name)) {
+        std::printf("%-24s missing: %s (--meshes names files in %s)\n", name.c_str(), (data + name).c_str(), data.c_str());
+        ok = false;
+      }
     summary.print();
     return ok;
   });
