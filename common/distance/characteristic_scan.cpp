@@ -5,71 +5,21 @@
 #include <bit>
 #include <cmath>
 #include <limits>
+#include <span>
 
 #include <tbb/parallel_for.h>
+#include <tbb/parallel_reduce.h>
 
 #include "core/huge_pages.hpp"
 #include "core/uninitialized_vector.hpp"
 #include "distance/brick_set.hpp"
-#include "distance/edge_uses.hpp"
-#include "distance/open_edges.hpp"
+#include "distance/collinear_segments.hpp"
+#include "distance/welded_adjacency.hpp"
 #include "geometry/point_triangle.hpp"
 
 namespace levelset {
 
 namespace {
-
-// Welded adjacency: per triangle edge the one other triangle across it (manifold edges only),
-// per welded vertex its lowest-index triangle and its neighbouring vertex positions.
-struct Adjacency {
-  std::vector<std::uint32_t> welded;          // per input vertex
-  std::vector<std::uint32_t> across;          // 3 per triangle: edge k = (v_k, v_k+1)
-  std::vector<std::uint32_t> first_triangle;  // per welded id (kNoTriangle: unused)
-  std::vector<std::uint32_t> ring_offsets;    // per welded id, CSR into ring_vertices
-  std::vector<std::uint32_t> ring_vertices;   // input vertex indices of distinct neighbours
-  std::uint64_t odd_edges = 0;                // edges used by an odd number of triangles
-};
-
-Adjacency build_adjacency(const TriangleMesh& mesh) {
-  Adjacency adj;
-  adj.welded = weld_exact(mesh.vertices);
-  const std::size_t nt = mesh.triangles.size(), nv = mesh.vertices.size();
-  const std::vector<EdgeUse> uses = sorted_edge_uses(mesh, adj.welded);
-  adj.across.assign(3 * nt, kNoTriangle);
-  adj.first_triangle.assign(nv, kNoTriangle);
-  // Distinct edges (first use of each run); the rings in CSR form, each vertex's neighbours in
-  // the order of the sorted edges (ascending).
-  std::vector<std::size_t> edge_starts;
-  adj.ring_offsets.assign(nv + 1, 0);
-  for (std::size_t i = 0; i < uses.size();) {
-    std::size_t j = i;
-    while (j < uses.size() && uses[j].same_edge(uses[i])) ++j;
-    if (j - i == 2 && uses[i].lo != uses[i].hi) {
-      adj.across[3 * uses[i].face + uses[i].slot] = uses[i + 1].face;
-      adj.across[3 * uses[i + 1].face + uses[i + 1].slot] = uses[i].face;
-    }
-    if (uses[i].lo != uses[i].hi && (j - i) % 2 == 1) ++adj.odd_edges;
-    if (uses[i].lo != uses[i].hi) {
-      edge_starts.push_back(i);
-      ++adj.ring_offsets[uses[i].lo + 1];
-      ++adj.ring_offsets[uses[i].hi + 1];
-    }
-    i = j;
-  }
-  for (std::size_t t = 0; t < nt; ++t)
-    for (int k = 0; k < 3; ++k) {
-      std::uint32_t& first = adj.first_triangle[adj.welded[mesh.triangles[t][k]]];
-      first = std::min(first, std::uint32_t(t));
-    }
-  for (std::size_t v = 0; v < nv; ++v) adj.ring_offsets[v + 1] += adj.ring_offsets[v];
-  adj.ring_vertices.resize(adj.ring_offsets[nv]);
-  std::vector<std::uint32_t> fill(adj.ring_offsets.begin(), adj.ring_offsets.end() - 1);
-  for (std::size_t i : edge_starts) {
-    adj.ring_vertices[fill[uses[i].lo]++] = uses[i].hi;
-    adj.ring_vertices[fill[uses[i].hi]++] = uses[i].lo;
-  }
-  return adj;
-}
 
 // A convex polyhedron: half-spaces g . x <= c and a world box containing it.
 struct Polyhedron {
@@ -329,7 +279,7 @@ void scan_prism(const TriangleFrame& tf, std::uint32_t t, double cover, Scanner&
 
 // The outward in-plane normal of `other` at the edge (p0, axis), or nothing when `other` is
 // degenerate.
-bool other_face_normal(const TriangleMesh& mesh, const Adjacency& adj, std::uint32_t other, const Vec3d& p0,
+bool other_face_normal(const TriangleMesh& mesh, const WeldedAdjacency& adj, std::uint32_t other, const Vec3d& p0,
                        const Vec3d& axis, std::uint32_t a, std::uint32_t b, double scale, Vec3d& out) {
   const auto& g = mesh.triangles[other];
   const Vec3d w[3] = {mesh.vertices[g[0]], mesh.vertices[g[1]], mesh.vertices[g[2]]};
@@ -352,7 +302,7 @@ struct EdgeWedge {
   Vec3d axis, m2;
 };
 
-EdgeWedge edge_wedge(const TriangleMesh& mesh, const Adjacency& adj, const TriangleFrame& tf, std::uint32_t t, int k) {
+EdgeWedge edge_wedge(const TriangleMesh& mesh, const WeldedAdjacency& adj, const TriangleFrame& tf, std::uint32_t t, int k) {
   EdgeWedge w;
   const Vec3d &p0 = tf.v[k], &p1 = tf.v[(k + 1) % 3];
   if (length(p1 - p0) == 0.0) {
@@ -363,7 +313,7 @@ EdgeWedge edge_wedge(const TriangleMesh& mesh, const Adjacency& adj, const Trian
   if (!tf.flat) return w;
   const auto& f = mesh.triangles[t];
   const std::uint32_t other = adj.across[3 * std::size_t(t) + std::size_t(k)];
-  w.bounded = other != kNoTriangle &&
+  w.bounded = other != kNoAdjacent &&
               other_face_normal(mesh, adj, other, p0, w.axis, adj.welded[f[k]], adj.welded[f[(k + 1) % 3]], tf.scale, w.m2);
   return w;
 }
@@ -444,7 +394,7 @@ bool surrounds(const Vec3d* dirs, int nd, const Vec3d& axis) {
 
 // Vertex k's cone: the points for which every edge at the vertex points away (the polar cone of
 // its welded edges), scanned once per welded vertex, by its lowest-index triangle.
-void scan_cone(const TriangleMesh& mesh, const Adjacency& adj, const TriangleFrame& tf, std::uint32_t t, int k,
+void scan_cone(const TriangleMesh& mesh, const WeldedAdjacency& adj, const TriangleFrame& tf, std::uint32_t t, int k,
                Scanner& scanner) {
   const auto& f = mesh.triangles[t];
   const std::uint32_t w = adj.welded[f[k]];
@@ -518,6 +468,76 @@ void scan_cone(const TriangleMesh& mesh, const Adjacency& adj, const TriangleFra
   scanner.scan(p, t, tf.n, tf.plane_margin);
 }
 
+// A degenerate face (not flat) whose vertices lie within 1e-6 h of its longest edge's line: that
+// edge (its index), or -1.
+int collinear_longest_edge(const Vec3d* v, double h) {
+  const Vec3d big = cross(v[1] - v[0], v[2] - v[0]);
+  const double twice_area = length(big);
+  int longest = 0;
+  double scale = 0;
+  for (int k = 0; k < 3; ++k) {
+    const double l = length(v[(k + 1) % 3] - v[k]);
+    if (l > scale) scale = l, longest = k;
+  }
+  const bool flat = twice_area > 1e-12 * scale * scale;  // as triangle_frame decides
+  return !flat && scale > 0 && twice_area / scale <= 1e-6 * h ? longest : -1;
+}
+
+// The collinear degenerate faces (by index) and the parts of their longest edges that no
+// lower-numbered one on the same line covers (collinear_segments.hpp): only those parts'
+// cylinders are scanned. Subdivided degenerate faces overlap many times over on their line.
+class CollinearFaces {
+ public:
+  CollinearFaces(const TriangleMesh& mesh, double h) {
+    faces_ = tbb::parallel_reduce(
+        tbb::blocked_range<std::uint32_t>(0, std::uint32_t(mesh.triangles.size()), 4096), std::vector<std::uint32_t>{},
+        [&](const tbb::blocked_range<std::uint32_t>& range, std::vector<std::uint32_t> found) {
+          for (std::uint32_t t = range.begin(); t != range.end(); ++t) {
+            const auto& f = mesh.triangles[t];
+            const Vec3d v[3] = {mesh.vertices[f[0]], mesh.vertices[f[1]], mesh.vertices[f[2]]};
+            if (collinear_longest_edge(v, h) >= 0) found.push_back(t);
+          }
+          return found;
+        },
+        [](std::vector<std::uint32_t> left, const std::vector<std::uint32_t>& right) {
+          left.insert(left.end(), right.begin(), right.end());
+          return left;
+        });
+    std::vector<std::array<Vec3d, 2>> segments;
+    segments.reserve(faces_.size());
+    for (const std::uint32_t t : faces_) {
+      const auto& f = mesh.triangles[t];
+      const Vec3d v[3] = {mesh.vertices[f[0]], mesh.vertices[f[1]], mesh.vertices[f[2]]};
+      const int k = collinear_longest_edge(v, h);
+      segments.push_back({v[k], v[(k + 1) % 3]});
+    }
+    parts_ = uncovered_segment_parts(segments, 1e-7 * h);
+  }
+  // The parts of face t's longest edge to scan (t must be a collinear face).
+  std::span<const std::array<Vec3d, 2>> parts_of(std::uint32_t t) const {
+    const std::size_t i = std::size_t(std::lower_bound(faces_.begin(), faces_.end(), t) - faces_.begin());
+    return {parts_.parts.data() + parts_.offsets[i], parts_.parts.data() + parts_.offsets[i + 1]};
+  }
+
+ private:
+  std::vector<std::uint32_t> faces_;  // ascending
+  SegmentParts parts_;
+};
+
+// The cylinder of radius W h about segment [a, b] between its end planes (a degenerate face's).
+void scan_cylinder(const Vec3d& a, const Vec3d& b, std::uint32_t t, const TriangleFrame& tf, Scanner& scanner) {
+  const Vec3d axis = unit(b - a);
+  if (length(axis) == 0.0) return;  // a rounding-length part: its neighbours' slack covers it
+  const double r = scanner.radius(), eps = scanner.slack();
+  Polyhedron p;
+  p.add_through(axis * -1.0, a, eps);
+  p.add_through(axis, b, eps);
+  const Vec3d e{r + eps, r + eps, r + eps};
+  p.lo = min(a, b) - e;
+  p.hi = max(a, b) + e;
+  scanner.scan(p, t, tf.n, tf.plane_margin);
+}
+
 // Thin wedges (nearly coplanar neighbours: smooth, densely triangulated surfaces) are scanned as
 // part of the face's prism, its edge planes moved out by the wedges' reach: a wedge's point x =
 // p + a m_k + b n (p on edge k, 0 <= a <= reach) has (x - v_j) . m_j <= a |m_k . m_j| <= reach
@@ -526,7 +546,8 @@ void scan_cone(const TriangleMesh& mesh, const Adjacency& adj, const TriangleFra
 // ~18 degrees, whose offset corners would move far.
 constexpr double kMaxWedgeCover = 0.25;  // voxels (measured: 1 and a tenth of the shortest edge gain no more)
 
-void scan_triangle_features(const TriangleMesh& mesh, const Adjacency& adj, std::uint32_t t, Scanner& scanner) {
+void scan_triangle_features(const TriangleMesh& mesh, const WeldedAdjacency& adj, const CollinearFaces& collinear,
+                            std::uint32_t t, Scanner& scanner) {
   const TriangleFrame tf = triangle_frame(mesh, t, scanner.radius(), scanner.voxel_size());
   EdgeWedge wedges[3];
   for (int k = 0; k < 3; ++k) wedges[k] = edge_wedge(mesh, adj, tf, t, k);
@@ -543,17 +564,12 @@ void scan_triangle_features(const TriangleMesh& mesh, const Adjacency& adj, std:
       cover = std::max(cover, reach + 2 * scanner.slack());
     }
     scan_prism(tf, t, cover, scanner);
-  } else {
+  } else if (const int longest = collinear_longest_edge(tf.v, scanner.voxel_size()); longest >= 0) {
     // A degenerate face whose vertices lie within 1e-6 h of its longest edge's line: that
-    // edge's cylinder holds its closest points to within that (the shorter edges are on it).
-    // Subdivided degenerate faces (CGAL's degtri_sliding.off) scanned all three cylinders.
-    int longest = 0;
-    for (int k = 1; k < 3; ++k)
-      if (length(tf.v[(k + 1) % 3] - tf.v[k]) > length(tf.v[(longest + 1) % 3] - tf.v[longest]))
-        longest = k;
-    const double twice_area = length(cross(tf.v[1] - tf.v[0], tf.v[2] - tf.v[0]));
-    if (tf.scale > 0 && twice_area / tf.scale <= 1e-6 * scanner.voxel_size())
-      for (int k = 0; k < 3; ++k) covered[k] = k != longest;
+    // edge's cylinder holds its closest points to within that (the shorter edges are on it),
+    // less the parts lower-numbered collinear faces scan (CollinearFaces).
+    for (int k = 0; k < 3; ++k) covered[k] = true;
+    for (const auto& [a, b] : collinear.parts_of(t)) scan_cylinder(a, b, t, tf, scanner);
   }
   for (int k = 0; k < 3; ++k)
     if (!covered[k]) scan_wedge(tf, t, k, wedges[k], scanner);
@@ -568,7 +584,8 @@ CharacteristicScanResult characteristic_scan(const TriangleMesh& mesh, const std
   const int reach = int(std::ceil((options.frame.half_width + 1.0) / kBrickDim));
   const BrickSet set = dilate_bricks(shell_bricks, reach);
   MinField field(set);
-  const Adjacency adj = build_adjacency(mesh);
+  const WeldedAdjacency adj = build_adjacency(mesh);
+  const CollinearFaces collinear(mesh, options.frame.voxel_size);
   std::atomic<std::uint64_t> evaluations{0}, polyhedra{0};
   const std::size_t nt = mesh.triangles.size(), batch = 1 << 16;
   for (std::size_t start = 0; start < nt; start += batch) {
@@ -576,7 +593,7 @@ CharacteristicScanResult characteristic_scan(const TriangleMesh& mesh, const std
     tbb::parallel_for(tbb::blocked_range<std::size_t>(start, end, 64), [&](const tbb::blocked_range<std::size_t>& range) {
       Scanner scanner(mesh, field, options.frame);
       for (std::size_t t = range.begin(); t != range.end(); ++t)
-        scan_triangle_features(mesh, adj, std::uint32_t(t), scanner);
+        scan_triangle_features(mesh, adj, collinear, std::uint32_t(t), scanner);
       evaluations += scanner.evaluations;
       polyhedra += scanner.polyhedra;
     });
