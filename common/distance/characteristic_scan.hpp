@@ -22,8 +22,11 @@
 //   keep this: an edge's wedge thinner than 1/4 voxel at the band's edge (nearly coplanar
 //   faces) is covered by the face's prism with its edge planes moved out by that much; a
 //   vertex whose ring lies in its face's plane, or whose cone is the vertex alone (a saddle),
-//   scans nothing; a voxel whose distance to a triangle's plane (less a rounding margin)
-//   exceeds its best distance so far is not evaluated against that triangle.
+//   scans nothing; a degenerate face whose vertices lie on one line scans its longest edge's
+//   cylinder, less the parts that lower-numbered collinear faces scan (collinear_segments.hpp:
+//   subdivided degenerate faces overlap many times over on their line); a voxel whose distance
+//   to a triangle's plane (less a rounding margin) exceeds its best distance so far is not
+//   evaluated against that triangle. The polyhedra's scan conversion: polyhedron_scan.hpp.
 // Cost: O(triangles * columns per polyhedron + band voxels * polyhedra per voxel); memory 8
 //   bytes per voxel of the dilated bricks. Threading: TBB over triangles (atomic minimum per
 //   voxel, order independent): identical results for any thread count.
