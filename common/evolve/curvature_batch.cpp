@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdint>
 
 #include "core/error.hpp"
 #include "evolve/curvature.hpp"
@@ -62,29 +63,48 @@ void mean_gauss_curvature_brick(const float* tile, std::ptrdiff_t origin, const 
                                 const BrickMask& active, const int* at, double h, float* mean, float* gauss) {
   if (stride[0] != 1) throw Error(ErrorCode::InvalidArgument, "mean_gauss_curvature_brick", "x must be the tile's fastest axis");
   const std::array<std::ptrdiff_t, kSamples> offset = sample_offsets(stride);
-  double s[kSamples][kBrickDim], m[kBrickDim], g[kBrickDim];
-  int k = 0;
-  for (int z = 0; z < kBrickDim; ++z)
+  // Pass 1: every row holding a voxel that takes its own curvature, all 8 lanes, kept per row.
+  double s[kSamples][kBrickDim], m[kBrickDim * kBrickDim][kBrickDim], g[kBrickDim * kBrickDim][kBrickDim];
+  std::uint64_t rows_done = 0;  // bit y + 8 z
+  for (int z = 0, k = 0; z < kBrickDim; ++z)
     for (int y = 0; y < kBrickDim; ++y) {
       const std::uint32_t row = std::uint32_t(active.words[std::size_t(z)] >> (8 * y)) & 0xffu;
       if (row == 0) continue;
       const std::ptrdiff_t first = origin + y * stride[1] + z * stride[2];
       bool own = false;  // some voxel of the row takes its own curvature
-      for (int i = 0, x = 0; x < kBrickDim; ++x)
-        if ((row >> x) & 1u) own |= at[k + i++] == first + x;
-      if (own) {
-        for (int j = 0; j < kSamples; ++j) {
-          const float* v = tile + first + offset[std::size_t(j)];
-          for (int x = 0; x < kBrickDim; ++x) s[j][x] = v[x];  // stride[0] == 1
-        }
-        row_curvature(s, h, m, g);
+      for (int x = 0; x < kBrickDim; ++x)
+        if ((row >> x) & 1u) own |= at[k++] == first + x;
+      if (!own) continue;
+      for (int j = 0; j < kSamples; ++j) {
+        const float* v = tile + first + offset[std::size_t(j)];
+        for (int x = 0; x < kBrickDim; ++x) s[j][x] = v[x];  // stride[0] == 1
       }
+      row_curvature(s, h, m[y + kBrickDim * z], g[y + kBrickDim * z]);
+      rows_done |= std::uint64_t{1} << (y + kBrickDim * z);
+    }
+  // Pass 2: each voxel's value. A voxel taking another centre's curvature (near the band's
+  // edge) reads that centre's lane where pass 1 computed its row (the same arithmetic, bit
+  // for bit), else mean_gauss_curvature_at.
+  for (int z = 0, k = 0; z < kBrickDim; ++z)
+    for (int y = 0; y < kBrickDim; ++y) {
+      const std::uint32_t row = std::uint32_t(active.words[std::size_t(z)] >> (8 * y)) & 0xffu;
+      const std::ptrdiff_t first = origin + y * stride[1] + z * stride[2];
       for (int x = 0; x < kBrickDim; ++x) {
         if (!((row >> x) & 1u)) continue;
-        const int a = at[k];
+        const std::ptrdiff_t a = at[k];
+        std::ptrdiff_t lane = -1;  // the centre's row (y + 8 z) * 8 + x where pass 1 computed it
         if (a == first + x) {
-          mean[k] = float(m[x]);
-          gauss[k] = float(g[x]);
+          lane = (y + kBrickDim * z) * kBrickDim + x;
+        } else if (a >= origin) {
+          // The centre's brick-local coordinates (a halo centre decodes to one >= 8 or below origin).
+          const std::ptrdiff_t rel = a - origin;
+          const std::ptrdiff_t az = rel / stride[2], ay = (rel % stride[2]) / stride[1], ax = rel % stride[1];
+          if (az < kBrickDim && ay < kBrickDim && ax < kBrickDim && ((rows_done >> (ay + kBrickDim * az)) & 1u))
+            lane = (ay + kBrickDim * az) * kBrickDim + ax;
+        }
+        if (lane >= 0) {
+          mean[k] = float(m[lane / kBrickDim][lane % kBrickDim]);
+          gauss[k] = float(g[lane / kBrickDim][lane % kBrickDim]);
         } else {
           const MeanGauss c = a >= 0 ? mean_gauss_curvature_at(tile + a, stride, h) : MeanGauss{};
           mean[k] = float(c.mean);

@@ -344,8 +344,9 @@ TEST(Curvature, DegenerateGradientGivesZeros) {
 
 // The brick form gives mean_gauss_curvature_at's values as floats, bit for bit, for every
 // active voxel of a brick: rows that take their own curvature (curvature of both signs,
-// saddles, a flat region with zero gradient: 0), voxels taking a neighbour's centre, and
-// voxels without one (-1: 0).
+// saddles, a flat region with zero gradient: 0), voxels taking a neighbour's centre inside
+// the brick (read from that centre's row) or in its halo on either side, and voxels without
+// one (-1: 0).
 TEST(Curvature, BrickFormEqualsSingleBitForBit) {
   const int n = 12;  // the brick at grid 2..9, its stencils within 1..10
   const double h = 0.3;
@@ -370,6 +371,11 @@ TEST(Curvature, BrickFormEqualsSingleBitForBit) {
           ++none;
         } else if (pattern == 2) {
           at.push_back(int(g.index(x + 2, y + 2, z + (z < 4 ? 3 : 1))));  // a neighbour along z
+          ++other;
+        } else if (pattern == 3) {
+          // A neighbour along -x, or -z on the brick's lowest layers: in the halo at x = 0 or
+          // z = 0 (below the brick's origin), else a centre whose row the brick form computes.
+          at.push_back(int(z < 2 ? g.index(x + 2, y + 2, z + 1) : g.index(x + 1, y + 2, z + 2)));
           ++other;
         } else {
           at.push_back(self);
