@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <iterator>
+#include <map>
 #include <numeric>
 #include <utility>
 
@@ -43,35 +45,26 @@ double off_line(const Vec3d& p, const Vec3d& origin, const Vec3d& d) {
   return length(r - d * dot(r, d));
 }
 
-using Intervals = std::vector<std::pair<double, double>>;  // sorted, disjoint
+using Parts = std::vector<std::pair<double, double>>;
+using Union = std::map<double, double>;  // disjoint intervals [start, end], by start
 
-// [lo, hi] less the union, then the union grows by [lo, hi].
-Intervals subtract_and_insert(Intervals& covered, double lo, double hi) {
-  Intervals parts;
-  double cursor = lo;
-  for (const auto& [u0, u1] : covered) {
-    if (u1 <= cursor) continue;
-    if (u0 >= hi) break;
-    if (u0 > cursor) parts.push_back({cursor, u0});
-    cursor = std::max(cursor, u1);
+// [lo, hi] less the union, then the union grows by [lo, hi]. O(log k) plus the intervals it
+// meets, each of which it merges away: O(n log n) over n inserts, also for a line dashed
+// into many disjoint pieces.
+Parts subtract_and_insert(Union& covered, double lo, double hi) {
+  Parts parts;
+  auto it = covered.upper_bound(lo);
+  if (it != covered.begin() && std::prev(it)->second > lo) --it;  // the interval holding lo
+  double cursor = lo, start = lo, end = hi;
+  while (it != covered.end() && it->first < hi) {
+    if (it->first > cursor) parts.push_back({cursor, it->first});
+    cursor = std::max(cursor, it->second);
+    start = std::min(start, it->first);
+    end = std::max(end, it->second);
+    it = covered.erase(it);
   }
   if (cursor < hi) parts.push_back({cursor, hi});
-  Intervals merged;
-  merged.reserve(covered.size() + 1);
-  bool placed = false;
-  auto push = [&](double a, double b) {
-    if (!merged.empty() && a <= merged.back().second) merged.back().second = std::max(merged.back().second, b);
-    else merged.push_back({a, b});
-  };
-  for (const auto& [u0, u1] : covered) {
-    if (!placed && lo < u0) {
-      push(lo, hi);
-      placed = true;
-    }
-    push(u0, u1);
-  }
-  if (!placed) push(lo, hi);
-  covered = std::move(merged);
+  covered.emplace(start, end);
   return parts;
 }
 
@@ -93,7 +86,7 @@ SegmentParts uncovered_segment_parts(std::span<const std::array<Vec3d, 2>> segme
     while (end < n && keys[order[end]] == keys[order[g]]) ++end;
     const std::array<Vec3d, 2>& first = segments[order[g]];
     const Vec3d d = canonical_direction(first);
-    Intervals covered;
+    Union covered;
     for (std::size_t m = g; m < end; ++m) {
       const std::uint32_t i = order[m];
       const std::array<Vec3d, 2>& s = segments[i];

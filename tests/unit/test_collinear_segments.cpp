@@ -102,5 +102,22 @@ TEST(CollinearSegments, RandomSegmentsOnSlantedLines) {
   EXPECT_LT(total_length(out), 0.5 * all);
 }
 
+// A line dashed into 200k disjoint pieces, then one segment over all of them: its parts are
+// the 200k gaps, found without a pass over the union per insert (that was quadratic: a hostile
+// mesh of collinear slivers would hang the scan).
+TEST(CollinearSegments, ManyDisjointPiecesOnOneLine) {
+  constexpr int kPieces = 200000;
+  std::vector<Segment> segments;
+  segments.reserve(kPieces + 1);
+  for (int i = 0; i < kPieces; ++i) segments.push_back({Vec3d{2.0 * i, 0, 0}, Vec3d{2.0 * i + 1.0, 0, 0}});
+  segments.push_back({Vec3d{-1, 0, 0}, Vec3d{2.0 * kPieces, 0, 0}});
+  const SegmentParts out = uncovered_segment_parts(segments, 1e-9);
+  ASSERT_EQ(out.offsets.size(), segments.size() + 1);
+  for (int i = 0; i < kPieces; ++i) ASSERT_EQ(out.offsets[std::size_t(i) + 1] - out.offsets[std::size_t(i)], 1u);
+  // The long one: the gap before the first piece and one after each piece.
+  EXPECT_EQ(out.offsets[kPieces + 1] - out.offsets[kPieces], std::uint32_t(kPieces + 1));
+  EXPECT_NEAR(total_length(out), 2.0 * kPieces + 1.0, 1e-6);
+}
+
 }  // namespace
 }  // namespace levelset
