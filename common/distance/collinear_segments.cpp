@@ -79,8 +79,10 @@ SegmentParts uncovered_segment_parts(std::span<const std::array<Vec3d, 2>> segme
   std::sort(order.begin(), order.end(), [&](std::uint32_t a, std::uint32_t b) {
     return keys[a] != keys[b] ? keys[a] < keys[b] : a < b;
   });
-  // Parts per segment, gathered per group, then laid out in segment order.
-  std::vector<std::vector<std::array<Vec3d, 2>>> per_segment(n);
+  // (segment, part) in group order, then laid out in segment order (counting sort; a
+  // segment's parts stay in their order along it).
+  std::vector<std::pair<std::uint32_t, std::array<Vec3d, 2>>> found;
+  found.reserve(n);
   for (std::size_t g = 0; g < n;) {
     std::size_t end = g + 1;
     while (end < n && keys[order[end]] == keys[order[g]]) ++end;
@@ -92,28 +94,28 @@ SegmentParts uncovered_segment_parts(std::span<const std::array<Vec3d, 2>> segme
       const std::array<Vec3d, 2>& s = segments[i];
       if (!(length(s[1] - s[0]) > 0) || !(length(first[1] - first[0]) > 0) ||
           !(off_line(s[0], first[0], d) <= tolerance && off_line(s[1], first[0], d) <= tolerance)) {
-        per_segment[i].push_back(s);  // near the group's line but not on it: alone
+        found.push_back({i, s});  // near the group's line but not on it: alone
         continue;
       }
       const double ta = dot(s[0] - first[0], d), tb = dot(s[1] - first[0], d);
       if (!(ta != tb)) {
-        per_segment[i].push_back(s);
+        found.push_back({i, s});
         continue;
       }
       // Along the segment itself, so that each part lies on it.
       auto at = [&](double t) { return s[0] + (s[1] - s[0]) * ((t - ta) / (tb - ta)); };
       for (const auto& [t0, t1] : subtract_and_insert(covered, std::min(ta, tb), std::max(ta, tb)))
-        per_segment[i].push_back({at(t0), at(t1)});
+        found.push_back({i, {at(t0), at(t1)}});
     }
     g = end;
   }
   SegmentParts out;
-  out.offsets.reserve(n + 1);
-  out.offsets.push_back(0);
-  for (auto& list : per_segment) {
-    out.parts.insert(out.parts.end(), list.begin(), list.end());
-    out.offsets.push_back(std::uint32_t(out.parts.size()));
-  }
+  out.offsets.assign(n + 1, 0);
+  for (const auto& [i, part] : found) ++out.offsets[i + 1];
+  for (std::size_t i = 0; i < n; ++i) out.offsets[i + 1] += out.offsets[i];
+  out.parts.resize(found.size());
+  std::vector<std::uint32_t> fill(out.offsets.begin(), out.offsets.end() - 1);
+  for (const auto& [i, part] : found) out.parts[fill[i]++] = part;
   return out;
 }
 
