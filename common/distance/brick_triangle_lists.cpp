@@ -10,6 +10,7 @@
 #include "core/error.hpp"
 #include "core/huge_pages.hpp"
 #include "core/index_hash_table.hpp"
+#include "geometry/point_triangle.hpp"
 #include "io/validate_mesh.hpp"
 
 namespace levelset {
@@ -42,10 +43,9 @@ void for_each_brick_near(const Vec3d& a, const Vec3d& b, const Vec3d& c, const G
     blo[ax] = static_cast<std::int32_t>(std::floor(i0 / kBrickDim));
     bhi[ax] = static_cast<std::int32_t>(std::floor(i1 / kBrickDim));
   }
-  Vec3d n = cross(b - a, c - a);
-  const double len = length(n);
-  const bool planar = len > 0.0 && std::isfinite(len);
-  if (planar) n = n / len;
+  const TrianglePlane plane = triangle_plane(a, b, c);
+  const Vec3d& n = plane.n;
+  const bool planar = plane.flat;
   const double half = 0.5 * (kBrickDim - 1) * h;  // brick box half extent (voxel centres)
   const double reach = margin + half * (std::abs(n.x) + std::abs(n.y) + std::abs(n.z));
   for (int z = blo.z; z <= bhi.z; ++z)
@@ -55,7 +55,8 @@ void for_each_brick_near(const Vec3d& a, const Vec3d& b, const Vec3d& c, const G
         if (planar) {
           const Coord o = brick_origin(bc);
           const Vec3d center = frame.origin + Vec3d{o.x + 3.5, o.y + 3.5, o.z + 3.5} * h;
-          if (std::abs(dot(n, center - a)) > reach) continue;
+          const Vec3d r = center - a;
+          if (std::abs(dot(n, r)) > reach + plane.error * (length(r) + 2 * half)) continue;
         }
         visit(bc);
       }

@@ -1,22 +1,22 @@
 #include "distance/characteristic_scan.hpp"
 
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <bit>
 #include <cmath>
 #include <limits>
 #include <span>
+#include <utility>
 
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_reduce.h>
 
 #include "core/huge_pages.hpp"
-#include "core/uninitialized_vector.hpp"
 #include "distance/brick_set.hpp"
 #include "distance/polyhedron_scan.hpp"
 #include "distance/collinear_segments.hpp"
 #include "distance/welded_adjacency.hpp"
-#include "geometry/point_triangle.hpp"
 
 namespace levelset {
 
@@ -272,27 +272,29 @@ int collinear_longest_edge(const Vec3d* v, double h) {
 class CollinearFaces {
  public:
   CollinearFaces(const TriangleMesh& mesh, double h) {
-    faces_ = tbb::parallel_reduce(
-        tbb::blocked_range<std::uint32_t>(0, std::uint32_t(mesh.triangles.size()), 4096), std::vector<std::uint32_t>{},
-        [&](const tbb::blocked_range<std::uint32_t>& range, std::vector<std::uint32_t> found) {
+    // (face, its longest edge) of every collinear face, in face order (the reduction joins
+    // left to right).
+    using Found = std::vector<std::pair<std::uint32_t, std::array<Vec3d, 2>>>;
+    const Found found = tbb::parallel_reduce(
+        tbb::blocked_range<std::uint32_t>(0, std::uint32_t(mesh.triangles.size()), 4096), Found{},
+        [&](const tbb::blocked_range<std::uint32_t>& range, Found part) {
           for (std::uint32_t t = range.begin(); t != range.end(); ++t) {
             const auto& f = mesh.triangles[t];
             const Vec3d v[3] = {mesh.vertices[f[0]], mesh.vertices[f[1]], mesh.vertices[f[2]]};
-            if (collinear_longest_edge(v, h) >= 0) found.push_back(t);
+            if (const int k = collinear_longest_edge(v, h); k >= 0) part.push_back({t, {v[k], v[(k + 1) % 3]}});
           }
-          return found;
+          return part;
         },
-        [](std::vector<std::uint32_t> left, const std::vector<std::uint32_t>& right) {
+        [](Found left, const Found& right) {
           left.insert(left.end(), right.begin(), right.end());
           return left;
         });
     std::vector<std::array<Vec3d, 2>> segments;
-    segments.reserve(faces_.size());
-    for (const std::uint32_t t : faces_) {
-      const auto& f = mesh.triangles[t];
-      const Vec3d v[3] = {mesh.vertices[f[0]], mesh.vertices[f[1]], mesh.vertices[f[2]]};
-      const int k = collinear_longest_edge(v, h);
-      segments.push_back({v[k], v[(k + 1) % 3]});
+    faces_.reserve(found.size());
+    segments.reserve(found.size());
+    for (const auto& [t, segment] : found) {
+      faces_.push_back(t);
+      segments.push_back(segment);
     }
     parts_ = uncovered_segment_parts(segments, 1e-7 * h);
   }

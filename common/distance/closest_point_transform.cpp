@@ -61,17 +61,17 @@ void scan_triangle(const Vec3d& a, const Vec3d& b, const Vec3d& c, std::uint32_t
     hi[ax] = std::min(kBrickDim - 1, int(std::floor((tmax[ax] + r - frame.origin[ax]) / h)) - o[ax]);
     if (lo[ax] > hi[ax]) return;
   }
-  // Slab along the dominant normal axis: |n.(p - a)| <= r bounds that coordinate per column.
-  Vec3d n = cross(b - a, c - a);
-  const double len = length(n);
+  // Slab along the dominant normal axis: |n.(p - a)| <= r bounds that coordinate per column
+  // (flat triangles only: a nearly collinear one's computed normal is noise).
+  const TrianglePlane plane = triangle_plane(a, b, c);
+  const Vec3d& n = plane.n;
   int axis = 2;
-  if (len > 0.0) {
-    n = n / len;
+  if (plane.flat) {
     const Vec3d an{std::abs(n.x), std::abs(n.y), std::abs(n.z)};
     axis = an.x >= an.y ? (an.x >= an.z ? 0 : 2) : (an.y >= an.z ? 1 : 2);
   }
   const int u = (axis + 1) % 3, v = (axis + 2) % 3;
-  const bool slab = len > 0.0 && std::abs(n[axis]) > 1e-3;
+  const bool slab = plane.flat && std::abs(n[axis]) > 1e-3 && plane.error < 1e-9;
   // Bounding sphere: |p - centre| - radius bounds the triangle distance from below.
   const Vec3d centre = (a + b + c) / 3.0;
   const double radius = std::sqrt(std::max(dot(a - centre, a - centre),

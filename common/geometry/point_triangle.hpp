@@ -6,13 +6,39 @@
 // and the squared distance |p - q|^2. Cost: ~60 flops, no allocation. Thread-safe.
 // Method: Voronoi-region classification of p against the triangle's vertices, edges and face
 // (Ericson, Real-Time Collision Detection, 5.1.5), written out here.
+//
+// triangle_plane: the unit normal of (a, b, c) where rounding leaves it meaningful (twice the
+// area above 1e-12 of the longest edge squared, triangle_frame's flatness too), with a bound
+// on its error: |n . (x - a)| is then within `error` |x - a| of the distance of x to the
+// triangle's plane. Nearly collinear triangles (a sliver or a subdivided degenerate face) get
+// none: their computed cross product is rounding noise, a random direction, and a plane test
+// with it culls what lies near them (the slab scan's binning and slabs did).
 #pragma once
 
 #include <algorithm>
+#include <cmath>
 
 #include "core/vec3.hpp"
 
 namespace levelset {
+
+struct TrianglePlane {
+  bool flat = false;   // n is meaningful
+  Vec3d n{0, 0, 0};    // unit normal (flat only)
+  double error = 0.0;  // bound on the relative error of plane distances with n
+};
+
+inline TrianglePlane triangle_plane(const Vec3d& a, const Vec3d& b, const Vec3d& c) {
+  TrianglePlane p;
+  const Vec3d big = cross(b - a, c - a);
+  const double len = length(big);
+  const double scale = std::max({length(b - a), length(c - b), length(a - c)});
+  if (!(len > 1e-12 * scale * scale) || !std::isfinite(len)) return p;
+  p.flat = true;
+  p.n = big / len;
+  p.error = 1e-15 * scale * scale / len;  // ~8 ulp of the cross product over its length
+  return p;
+}
 
 struct TrianglePoint {
   Vec3d point;
