@@ -47,7 +47,10 @@ void for_each_brick_near(const Vec3d& a, const Vec3d& b, const Vec3d& c, const G
   const Vec3d& n = plane.n;
   const bool planar = plane.flat;
   const double half = 0.5 * (kBrickDim - 1) * h;  // brick box half extent (voxel centres)
-  const double reach = margin + half * (std::abs(n.x) + std::abs(n.y) + std::abs(n.z));
+  // The normal's rounding over the farthest brick centre considered (the triangle's box grown
+  // by the margin and a brick): a constant per triangle.
+  const double far = length(hi - lo) + 4 * half;
+  const double reach = margin + half * (std::abs(n.x) + std::abs(n.y) + std::abs(n.z)) + plane.error * far;
   for (int z = blo.z; z <= bhi.z; ++z)
     for (int y = blo.y; y <= bhi.y; ++y)
       for (int x = blo.x; x <= bhi.x; ++x) {
@@ -55,8 +58,7 @@ void for_each_brick_near(const Vec3d& a, const Vec3d& b, const Vec3d& c, const G
         if (planar) {
           const Coord o = brick_origin(bc);
           const Vec3d center = frame.origin + Vec3d{o.x + 3.5, o.y + 3.5, o.z + 3.5} * h;
-          const Vec3d r = center - a;
-          if (std::abs(dot(n, r)) > reach + plane.error * (length(r) + 2 * half)) continue;
+          if (std::abs(dot(n, center - a)) > reach) continue;
         }
         visit(bc);
       }

@@ -32,11 +32,11 @@ inline TrianglePlane triangle_plane(const Vec3d& a, const Vec3d& b, const Vec3d&
   TrianglePlane p;
   const Vec3d big = cross(b - a, c - a);
   const double len = length(big);
-  const double scale = std::max({length(b - a), length(c - b), length(a - c)});
-  if (!(len > 1e-12 * scale * scale) || !std::isfinite(len)) return p;
+  const double scale2 = std::max({dot(b - a, b - a), dot(c - b, c - b), dot(a - c, a - c)});  // longest edge^2
+  if (!(len > 1e-12 * scale2) || !std::isfinite(len)) return p;
   p.flat = true;
   p.n = big / len;
-  p.error = 1e-15 * scale * scale / len;  // ~8 ulp of the cross product over its length
+  p.error = 1e-15 * scale2 / len;  // ~8 ulp of the cross product over its length
   return p;
 }
 
