@@ -156,6 +156,7 @@ struct ReconstructionOptions {
   bool carve_gaps = true;       // finer levels: reopen gaps the start shell closed over buried points
   bool pierce_tunnels = true;   // carve_gaps: a gap lined almost only by buried points may reopen as a tunnel
   bool narrow_gaps = true;      // carve_gaps: a second carving reopens gaps narrower than the sampling gap's clearance
+  bool cut_webs = true;         // carve_gaps: sheets of the inside exposed to the outside and clear of every point are cut where that removes a handle
   bool denoised_clearance = true;  // carve_gaps under noise (sigma > 0.5 final voxels): clearance from points projected onto their planes
   int max_resolution = 4096;    // cap on the final grid's longest side (voxels)
   ProgressHook progress;
@@ -180,7 +181,8 @@ struct ReconstructionStage {
   std::uint64_t dropped_components = 0;  // coarsest level: components without data turned to the other sign
   std::uint64_t buried_points = 0;  // finer levels: points buried inside the upsampled front
   int carved_regions = 0;           // finer levels: closed gaps reopened (turned outside)
-  int pierced_regions = 0;          // of them reopened whole, tunnels allowed (pierce_tunnels)
+  int pierced_regions = 0;          // of them reopened whole, tunnels allowed (pierce_tunnels), or webs cut
+  int webs_cut = 0;                 // of those, webs (cut_webs)
   std::uint64_t carved_voxels = 0;
   std::uint64_t active_voxels = 0;
   std::uint64_t fit_voxels = 0; // local fits computed (cache, or snapped voxels of all passes)

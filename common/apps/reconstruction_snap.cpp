@@ -530,6 +530,7 @@ SnapOutput snap_level(NarrowBand band, const PointIndex& index, const Reconstruc
     stage.buried_points = carved.buried;
     stage.carved_regions = carved.regions;
     stage.pierced_regions = carved.pierced_regions;
+    stage.webs_cut = carved.webs;
     stage.carved_voxels = carved.carved_voxels;
     carved_bricks = std::move(carved.bricks);
   }
