@@ -30,17 +30,6 @@ namespace {
 // Buried points per candidate-gathering chunk (each gathers up to ~(4/3) pi reach^3 keys).
 constexpr std::size_t kCarveChunk = 2048;
 
-// A voxel key: 21 bits per axis after an offset (voxel indices of the level's grid).
-constexpr std::int64_t kKeyBias = 1 << 20;
-std::uint64_t key_of(const Coord& c) {
-  return (std::uint64_t(c.x + kKeyBias) << 42) | (std::uint64_t(c.y + kKeyBias) << 21) | std::uint64_t(c.z + kKeyBias);
-}
-Coord coord_of(std::uint64_t k) {
-  const std::int64_t mask = (std::int64_t{1} << 21) - 1;
-  return Coord{int(std::int64_t(k >> 42) - kKeyBias), int(std::int64_t((k >> 21) & std::uint64_t(mask)) - kKeyBias),
-               int(std::int64_t(k & std::uint64_t(mask)) - kKeyBias)};
-}
-
 std::uint32_t find_root(std::vector<std::uint32_t>& parent, std::uint32_t i) {
   while (parent[i] != i) {
     parent[i] = parent[parent[i]];
@@ -266,11 +255,8 @@ std::vector<std::uint32_t> label_regions(const std::vector<std::uint64_t>& air) 
   return root;
 }
 
-// The Euler characteristic the inside loses when the voxels `region` (sorted keys, all inside)
-// turn outside: the alternating count of the cells of the inside's cubical complex (voxels as
-// vertices, 6-adjacent pairs as edges, 2x2 squares, 2x2x2 cubes, all voxels inside) that hold
-// a voxel of the region. chi = components - tunnels + cavities, so a removal that cuts a
-// handle or splits a part returns <= -1, one that opens a tunnel or a cavity >= 1.
+}  // namespace
+
 std::int64_t euler_lost(BandAccessor& acc, const std::vector<std::uint64_t>& region) {
   std::vector<std::uint64_t> anchors;
   for (const std::uint64_t k : region) {
@@ -301,6 +287,8 @@ std::int64_t euler_lost(BandAccessor& acc, const std::vector<std::uint64_t>& reg
   }
   return lost;
 }
+
+namespace {
 
 // Steps 2-4: which candidates are carved (sorted keys) and which of them pierced, with the
 // counts of regions.

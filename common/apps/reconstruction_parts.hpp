@@ -150,6 +150,24 @@ struct CarveOutput {
   int webs = 0;                     // of those, webs cut (cut_webs)
   std::vector<std::uint64_t> bricks;  // brick_key of the bricks with carved voxels and their 26 neighbours, sorted
 };
+// A voxel key: 21 bits per axis after an offset (voxel indices of the level's grid).
+inline constexpr std::int64_t kKeyBias = 1 << 20;
+inline std::uint64_t key_of(const Coord& c) {
+  return (std::uint64_t(c.x + kKeyBias) << 42) | (std::uint64_t(c.y + kKeyBias) << 21) | std::uint64_t(c.z + kKeyBias);
+}
+inline Coord coord_of(std::uint64_t k) {
+  const std::int64_t mask = (std::int64_t{1} << 21) - 1;
+  return Coord{int(std::int64_t(k >> 42) - kKeyBias), int(std::int64_t((k >> 21) & std::uint64_t(mask)) - kKeyBias),
+               int(std::int64_t(k & std::uint64_t(mask)) - kKeyBias)};
+}
+
+// The Euler characteristic the inside loses when the voxels `region` (sorted keys, all inside)
+// turn outside: the alternating count of the cells of the inside's cubical complex (voxels as
+// vertices, 6-adjacent pairs as edges, 2x2 squares, 2x2x2 cubes, all voxels inside) that hold
+// a voxel of the region. chi = components - tunnels + cavities, so a removal that cuts a
+// handle or splits a part returns <= -1, one that opens a tunnel or a cavity to the outside
+// >= 1, a dent 0. Cost: O(|region|) accessor probes (27 per voxel).
+std::int64_t euler_lost(BandAccessor& acc, const std::vector<std::uint64_t>& region);
 CarveOutput carve_buried_gaps(NarrowBand band, const PointIndex& index, const CarveSettings& settings,
                               const ProgressHook& progress);
 
