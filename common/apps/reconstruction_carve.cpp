@@ -296,23 +296,20 @@ struct RegionChoice {
   std::vector<std::uint64_t> carved, pierced;
   int regions = 0, pierced_regions = 0, webs = 0;
 };
-RegionChoice carve_regions(const NarrowBand& band, const PointIndex& index, const std::vector<std::uint64_t>& air,
-                           const std::vector<float>& value, double lining_depth, double clearance, bool allow_pierce,
-                           bool cut_webs) {
+// Steps 2-3: per region (indexed by its root in label_regions), its size, its faces on the
+// outside (mouth), its voxels with such a face (exposed), and its lining: the points within
+// clearance + 1.5 h of its boundary voxels, and of them those deeper than lining_depth.
+struct RegionStats {
+  std::vector<std::uint32_t> size, mouth, exposed, lining, lining_buried;
+};
+RegionStats region_stats(const NarrowBand& band, const PointIndex& index, const std::vector<std::uint64_t>& air,
+                         const std::vector<std::uint32_t>& root, const std::vector<float>& value, double lining_depth,
+                         double clearance) {
   const double h = band.voxel_size();
-  RegionChoice out;
-  // 2. Regions: 6-connected components of the candidates.
-  const std::vector<std::uint32_t> root = label_regions(air);
   auto find = [&](const Coord& c) { return std::binary_search(air.begin(), air.end(), key_of(c)); };
   const Coord steps[6] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
-  // 3. A region is a closed gap when it meets the outside through a mouth (the shell spans
-  // it: at least kMinMouthShare size^(2/3) faces, the gap's width across) and the points
-  // lining it are mostly buried (a gap's walls); a part's own interior meets the outside only
-  // through a hole in the sampling or a dent of the front, a face or a few, and its lining is
-  // the part's surface, mostly on the front.
-  std::vector<std::uint32_t> mouth(air.size(), 0);  // faces between the region and the outside
-  std::vector<std::uint32_t> size(air.size(), 0), exposed(air.size(), 0);
-  std::vector<std::uint32_t> lining(air.size(), 0), lining_buried(air.size(), 0);
+  RegionStats st;
+  for (auto* v : {&st.size, &st.mouth, &st.exposed, &st.lining, &st.lining_buried}) v->assign(air.size(), 0);
   std::vector<std::uint8_t> is_buried(index.size(), 0);
   // The lining counts the points below the front (deeper than max(1.5 h, 2 noise), not the
   // burial depth): under noise the walls of a closed gap near its mouth lie shallower than
@@ -325,27 +322,57 @@ RegionChoice carve_regions(const NarrowBand& band, const PointIndex& index, cons
   for (std::size_t i = 0; i < air.size(); ++i) {
     const Coord c = coord_of(air[i]);
     const std::uint32_t r = root[i];
-    ++size[r];
+    ++st.size[r];
     bool boundary = false, open = false;
     for (const Coord& step : steps) {
       const Coord q = c + step;
       if (find(q)) continue;
       boundary = true;
       if (!acc.is_inside(q)) {
-        ++mouth[r];
+        ++st.mouth[r];
         open = true;
       }
     }
-    exposed[r] += open;
+    st.exposed[r] += open;
     if (!boundary) continue;
     index.within(band.world(c), clearance + 1.5 * h, near);
     for (const auto& [p, d2] : near) {
       if (seen_by[p] == r) continue;
       seen_by[p] = r;
-      ++lining[r];
-      lining_buried[r] += is_buried[p];
+      ++st.lining[r];
+      st.lining_buried[r] += is_buried[p];
     }
   }
+  return st;
+}
+
+// The candidates' indices grouped by region (a region's keys stay sorted) and where each
+// region's group starts (indexed by its root).
+struct RegionGroups {
+  std::vector<std::uint32_t> order, start;
+};
+RegionGroups group_by_region(const std::vector<std::uint32_t>& root) {
+  RegionGroups g;
+  g.order.resize(root.size());
+  std::iota(g.order.begin(), g.order.end(), 0u);
+  std::stable_sort(g.order.begin(), g.order.end(), [&](std::uint32_t a, std::uint32_t b) { return root[a] < root[b]; });
+  g.start.assign(root.size() + 1, 0);
+  for (std::size_t j = g.order.size(); j-- > 0;) g.start[root[g.order[j]]] = std::uint32_t(j);
+  return g;
+}
+
+RegionChoice carve_regions(const NarrowBand& band, const PointIndex& index, const std::vector<std::uint64_t>& air,
+                           const std::vector<float>& value, double lining_depth, double clearance, bool allow_pierce,
+                           bool cut_webs) {
+  RegionChoice out;
+  // 2. Regions: 6-connected components of the candidates.
+  const std::vector<std::uint32_t> root = label_regions(air);
+  // 3. A region is a closed gap when it meets the outside through a mouth (the shell spans
+  // it: at least kMinMouthShare size^(2/3) faces, the gap's width across) and the points
+  // lining it are mostly buried (a gap's walls); a part's own interior meets the outside only
+  // through a hole in the sampling or a dent of the front, a face or a few, and its lining is
+  // the part's surface, mostly on the front.
+  const RegionStats st = region_stats(band, index, air, root, value, lining_depth, clearance);
   // 4. Carved regions; those large and lined almost only by buried points may also open
   // tunnels (a hole through a plate: the air meets the outside at both mouths). A region
   // lined almost only by buried points is a gap the shell sealed even where its mouth is a
@@ -353,37 +380,31 @@ RegionChoice carve_regions(const NarrowBand& band, const PointIndex& index, cons
   // interior reached through a pinhole is lined by the part's surface (handle.off's: 74 %
   // buried, beside its slot).
   // Webs (cut_webs): a region with at least kWebExposure of its voxels touching the outside is
-  // a sheet of the inside that no point supports (the shell spanning a gap: homer's legs and arms, man's
-  // at 200k points); it is cut (turned outside whole) where that removes a handle or splits
-  // a part (euler_lost < 0), never where it would open a tunnel (a web only partly clear of
-  // the points: cow and camel at 200k points gained handles).
+  // a sheet of the inside that no point supports (the shell spanning a gap: homer's legs and
+  // arms, man's at 200k points); it is cut (turned outside whole) where that removes a handle
+  // or splits a part (euler_lost < 0), never where it would open a tunnel (a web only partly
+  // clear of the points: cow and camel at 200k points gained handles).
   std::vector<std::uint8_t> carve(air.size(), 0), pierce(air.size(), 0);
-  std::vector<std::uint32_t> by_region;  // air indices grouped by region, keys sorted within one
-  std::vector<std::uint32_t> region_start;
-  if (cut_webs) {
-    by_region.resize(air.size());
-    std::iota(by_region.begin(), by_region.end(), 0u);
-    std::stable_sort(by_region.begin(), by_region.end(), [&](std::uint32_t a, std::uint32_t b) { return root[a] < root[b]; });
-    region_start.assign(air.size() + 1, 0);
-    for (std::size_t j = by_region.size(); j-- > 0;) region_start[root[by_region[j]]] = std::uint32_t(j);
-  }
+  const RegionGroups groups = cut_webs ? group_by_region(root) : RegionGroups{};
+  BandAccessor acc(band);
   std::vector<std::uint64_t> members;
   for (std::size_t i = 0; i < air.size(); ++i) {
     const std::uint32_t r = root[i];
-    if (r != i || size[r] < kMinCarveVoxels) continue;
-    const bool sealed = mouth[r] > 0 && double(lining_buried[r]) >= kSealedGapLining * double(lining[r]);
-    const bool has_mouth = sealed || double(mouth[r]) >= kMinMouthShare * std::cbrt(double(size[r]) * double(size[r]));
+    const double size = st.size[r], lining = st.lining[r], buried = st.lining_buried[r];
+    if (r != i || size < kMinCarveVoxels) continue;
+    const bool sealed = st.mouth[r] > 0 && buried >= kSealedGapLining * lining;
+    const bool has_mouth = sealed || double(st.mouth[r]) >= kMinMouthShare * std::cbrt(size * size);
     bool web = false;
-    if (cut_webs && double(exposed[r]) >= kWebExposure * double(size[r])) {
+    if (cut_webs && double(st.exposed[r]) >= kWebExposure * size) {
       members.clear();
-      for (std::uint32_t j = region_start[r]; j < region_start[r] + size[r]; ++j) members.push_back(air[by_region[j]]);
+      for (std::uint32_t j = groups.start[r]; j < groups.start[r] + st.size[r]; ++j) members.push_back(air[groups.order[j]]);
       web = euler_lost(acc, members) < 0;
     }
-    const bool gap = has_mouth && double(lining_buried[r]) >= kMinBuriedLining * double(lining[r]);
+    const bool gap = has_mouth && buried >= kMinBuriedLining * lining;
     if (!web && !gap) continue;
     carve[r] = 1;
     ++out.regions;
-    if (web || (allow_pierce && size[r] >= kMinPierceVoxels && double(lining_buried[r]) >= kMinPierceLining * double(lining[r]))) {
+    if (web || (allow_pierce && size >= kMinPierceVoxels && buried >= kMinPierceLining * lining)) {
       pierce[r] = 1;
       ++out.pierced_regions;
       out.webs += web;
