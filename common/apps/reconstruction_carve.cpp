@@ -445,7 +445,18 @@ void drop_web_scraps(NarrowBand& band, const std::vector<std::uint64_t>& cut) {
       }
     }
   }
-  if (any) flip_components(band, comps, drop);
+  if (!any) return;
+  std::vector<float> values(band.values().begin(), band.values().end());
+  const float eps = float(1e-3 * band.voxel_size());
+  for (std::uint32_t b = 0; b < band.brick_count(); ++b) {
+    std::size_t slot = band.bricks()[b].value_offset;
+    band.for_each_active_in_brick(b, [&](const Coord& c, float v) {
+      const std::size_t i = slot++;
+      const std::int32_t l = comps.label[comps.index_of(c)];
+      if (l >= 0 && drop[std::size_t(l)]) values[i] = std::max(-v, eps);
+    });
+  }
+  band.swap_values(values);
 }
 
 // 5. The band with the chosen regions dug out (see below), how many voxels turned outside and

@@ -134,7 +134,17 @@ std::uint64_t drop_unsupported_components(NarrowBand& band, const PointIndex& in
     }
   }
   if (dropped == 0) return 0;
-  flip_components(band, comps, drop);
+  std::vector<float> values(band.values().begin(), band.values().end());
+  const float eps = float(1e-3 * band.voxel_size());
+  for (std::uint32_t b = 0; b < band.brick_count(); ++b) {
+    std::size_t slot = band.bricks()[b].value_offset;
+    band.for_each_active_in_brick(b, [&](const Coord& c, float v) {
+      const std::size_t i = slot++;
+      if (!drop[std::size_t(comps.label[comps.index_of(c)])]) return;
+      values[i] = v < 0.0f ? std::max(-v, eps) : std::min(-v, -eps);
+    });
+  }
+  band.swap_values(values);
   return dropped;
 }
 

@@ -213,18 +213,4 @@ NarrowBand upsample(const NarrowBand& coarse, double half_width, const ProgressH
   return builder.finish(coarse.far_inside());
 }
 
-void flip_components(NarrowBand& band, const SignComponentsResult& comps, const std::vector<std::uint8_t>& flip) {
-  std::vector<float> values(band.values().begin(), band.values().end());
-  const float eps = float(1e-3 * band.voxel_size());
-  for (std::uint32_t b = 0; b < band.brick_count(); ++b) {
-    std::size_t slot = band.bricks()[b].value_offset;
-    band.for_each_active_in_brick(b, [&](const Coord& c, float v) {
-      const std::size_t i = slot++;
-      const std::int32_t l = comps.label[comps.index_of(c)];
-      if (l >= 0 && flip[std::size_t(l)]) values[i] = v < 0.0f ? std::max(-v, eps) : std::min(-v, -eps);
-    });
-  }
-  band.swap_values(values);
-}
-
 }  // namespace levelset::apps::detail

@@ -21,7 +21,6 @@
 #include "core/progress.hpp"
 #include "grid/band_accessor.hpp"
 #include "grid/narrow_band.hpp"
-#include "grid/sign_components.hpp"
 
 namespace levelset::apps::detail {
 
@@ -45,9 +44,6 @@ double coarse_field_at(BandAccessor& acc, const NarrowBand& coarse, const std::v
 double field_at(BandAccessor& acc, const NarrowBand& band, const std::vector<float>& field, const Coord& c);
 // The next level's band: `coarse` at half the voxel size, half-width `half_width` voxels.
 NarrowBand upsample(const NarrowBand& coarse, double half_width, const ProgressHook& progress);
-// The active voxels of the components `flip` marks (indexed as comps.components; comps
-// labelled on `band`) turned to the other sign: each value mirrored, at least 1e-3 h from zero.
-void flip_components(NarrowBand& band, const SignComponentsResult& comps, const std::vector<std::uint8_t>& flip);
 
 // ---- reconstruction_flow.cpp
 // The coarsest level's flow from the start shell `band` (voxel size h) toward the points'
