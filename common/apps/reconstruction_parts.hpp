@@ -77,7 +77,8 @@ LevelOutput flow_level(NarrowBand band, const PointIndex& index, const Reconstru
 // outside (a sheet of the inside clear of every point: the shell spanning a gap, partly
 // closed where the gap narrows) turns outside whole where that raises the inside's Euler
 // characteristic (it cuts a handle or splits a part), never where it would open a tunnel or
-// a cavity. Nothing happens
+// a cavity; inside pieces of fewer than kMinPierceVoxels voxels a cut leaves beside it turn
+// outside too. Nothing happens
 // with fewer than max(kMinBuried, kMinBuriedShare N) buried points, or more than
 // kMaxBuriedShare N (then the front is not near the data at all, and the candidates would be
 // ~reach^3 voxels per point: work and memory stay bounded). With settings.narrow, a second carving of the
