@@ -26,9 +26,13 @@ using namespace scan_detail;
 
 // The box of p0 + R d over a 2D cone of unit directions (between d1 and d2 through mid, angle
 // with cosine cos_theta) and both edge ends, or the whole cylinder's box when the cone is wide.
+// Wedges opening wider than this (cosine of the opening; 120 degrees) are scanned over the
+// cylinder's box.
+constexpr double kWideCos = -0.5;
+
 void wedge_box(Polyhedron& p, const Vec3d& p0, const Vec3d& p1, const Vec3d& d1, const Vec3d& d2, const Vec3d& mid,
                double cos_theta, double r) {
-  if (cos_theta < -0.5) {  // wider than 120 degrees: the cylinder's box
+  if (cos_theta < kWideCos) {  // the cylinder's box
     const Vec3d e{r, r, r};
     p.lo = min(p0, p1) - e;
     p.hi = max(p0, p1) + e;
@@ -124,6 +128,15 @@ double wedge_reach(const TriangleFrame& tf, int k, const EdgeWedge& w, double r)
   return r * std::sqrt(std::max(0.0, 1.0 - c * c));
 }
 
+// The rounding margin of a feature bound (FeatureBound) over a triangle's band: the
+// cancellation in a line distance (squared length less squared projection: sqrt(u) times the
+// lengths involved), the coordinates' rounding, and 1e-4 h to spare.
+double feature_rounding(const TriangleFrame& tf, double r, double h) {
+  double coords = 0;
+  for (const Vec3d& v : tf.v) coords = std::max({coords, std::abs(v.x), std::abs(v.y), std::abs(v.z)});
+  return 1e-4 * h + 1e-7 * (tf.scale + r) + 1e-14 * (coords + r);
+}
+
 // Edge k's wedge: beyond the edge as seen from this face (and from the face across it, when the
 // edge is manifold), between the planes through its ends.
 void scan_wedge(const TriangleFrame& tf, std::uint32_t t, int k, const EdgeWedge& w, Scanner& scanner) {
@@ -136,6 +149,7 @@ void scan_wedge(const TriangleFrame& tf, std::uint32_t t, int k, const EdgeWedge
   const Vec3d e{r + eps, r + eps, r + eps};
   p.lo = min(p0, p1) - e;  // the cylinder's box unless the wedge is narrower
   p.hi = max(p0, p1) + e;
+  bool wide = true;  // scanned over the cylinder's box
   if (tf.flat) {
     p.add_through(tf.m[k] * -1.0, p0, eps);
     if (w.bounded) {
@@ -149,10 +163,22 @@ void scan_wedge(const TriangleFrame& tf, std::uint32_t t, int k, const EdgeWedge
       // The opening's cosine from the in-plane normals (pi - angle(m, m2)), not from d1 . d2:
       // for a face folded back onto its neighbour (m2 ~ m) the sides' flips above are
       // ambiguous, and d1 . d2 could read a half-space as a thin wedge.
-      wedge_box(p, p0, p1, d1, d2, unit(sum), std::clamp(-dot(tf.m[k], w.m2), -1.0, 1.0), r + eps);
+      const double cos_theta = std::clamp(-dot(tf.m[k], w.m2), -1.0, 1.0);
+      wedge_box(p, p0, p1, d1, d2, unit(sum), cos_theta, r + eps);
+      wide = cos_theta < kWideCos;
     }
   }
-  scanner.scan(p, t, tf.n, tf.plane_margin);
+  // Flat faces: x in the wedge has (x - p0) . m_k >= -eps, so its distance to the face is at
+  // least its distance to the edge's line less eps (only the in-plane part across the line
+  // can be nearer, by at most eps). Only for wide wedges (see FeatureBound).
+  FeatureBound line;
+  if (tf.flat && wide) {
+    line.kind = FeatureBound::Kind::line;
+    line.origin = p0;
+    line.axis = w.axis;
+    line.margin = eps + feature_rounding(tf, r, scanner.voxel_size());
+  }
+  scanner.scan(p, t, tf.n, tf.plane_margin, line);
 }
 
 // All rays on one line (the cone of a flat vertex is the normal line, +-n).
@@ -173,6 +199,24 @@ bool surrounds(const Vec3d* dirs, int nd, const Vec3d& axis) {
   double gap = angles[0] + 2.0 * M_PI - angles[nd - 1];
   for (int i = 1; i < nd; ++i) gap = std::max(gap, angles[i] - angles[i - 1]);
   return gap < M_PI - 1e-6;
+}
+
+// The cone's bound: with every edge at v as a constraint (x - v) . u <= eps (u unit), face t's
+// two edges among them (u1, u2, angle alpha at v), a point y = v + a u1 + b u2 of t (a, b >= 0)
+// has (x - v) . (y - v) <= eps (a + b) <= eps K |y - v|, K = 1 / cos(alpha / 2), so
+// |x - y|^2 >= |x - v|^2 - (eps K)^2: the distance is at least |x - v| - eps K. None for
+// degenerate faces, rings past the polyhedron's 24 planes, or angles within 0.1 degree of pi.
+FeatureBound cone_bound(const TriangleFrame& tf, int k, double eps, std::uint32_t ring, double r, double h) {
+  FeatureBound bound;
+  if (!tf.flat || ring > 24) return bound;
+  const Vec3d& v = tf.v[k];
+  const Vec3d u1 = unit(tf.v[(k + 1) % 3] - v), u2 = unit(tf.v[(k + 2) % 3] - v);
+  const double half_cos = std::sqrt(std::max(0.0, 0.5 * (1.0 + dot(u1, u2))));
+  if (!(half_cos > 1e-3)) return bound;
+  bound.kind = FeatureBound::Kind::point;
+  bound.origin = v;
+  bound.margin = eps / half_cos + feature_rounding(tf, r, h);
+  return bound;
 }
 
 // Vertex k's cone: the points for which every edge at the vertex points away (the polar cone of
@@ -238,7 +282,8 @@ void scan_cone(const TriangleMesh& mesh, const WeldedAdjacency& adj, const Trian
   const Vec3d e{r + eps, r + eps, r + eps};
   p.lo = v - e;
   p.hi = v + e;
-  if (!capped && !overflow && nr >= 2 && min_cos >= -0.4) {  // at most ~114 degrees apart
+  const bool wide = !(!capped && !overflow && nr >= 2 && min_cos >= -0.4);  // the ball's box
+  if (!wide) {  // rays at most ~114 degrees apart
     const double reach = 1.5 * (r + eps) / std::sqrt(0.5 * (1.0 + min_cos));  // 1.5 R / cos(angle / 2)
     Vec3d pts[65];
     pts[0] = v;
@@ -248,7 +293,8 @@ void scan_cone(const TriangleMesh& mesh, const WeldedAdjacency& adj, const Trian
     p.lo = max(box.lo, p.lo);
     p.hi = min(box.hi, p.hi);
   }
-  scanner.scan(p, t, tf.n, tf.plane_margin);
+  const std::uint32_t ring = adj.ring_offsets[w + 1] - adj.ring_offsets[w];
+  scanner.scan(p, t, tf.n, tf.plane_margin, wide ? cone_bound(tf, k, eps, ring, r, scanner.voxel_size()) : FeatureBound{});
 }
 
 // A degenerate face (not flat) whose vertices lie within 1e-6 h of its longest edge's line: that

@@ -24,6 +24,7 @@ struct MarchTile {
   using G = TileGeom<Halo>;
   alignas(64) float val[G::kVoxels];
   alignas(64) std::uint8_t st[G::kVoxels];
+  alignas(64) float cap[G::kVoxels];  // the free voxels' limits
 };
 
 // Upwind update of tile voxel t from the known voxels on its own side of the interface and
@@ -83,6 +84,7 @@ BrickPass march_brick(RedistanceDomain& w, std::uint32_t b, const BrickMask& fre
   MarchTile<Halo> m;
   std::fill(m.val, m.val + G::kVoxels, kInf);
   std::fill(m.st, m.st + G::kVoxels, std::uint8_t{0});
+  const float* cap = w.cap.empty() ? nullptr : w.cap.data() + std::size_t(b) * kBrickVoxels;
   TrialHeap& heap = scratch;
   heap.clear();
   auto put = [&](std::uint32_t src, int n, int t, bool own) {
@@ -93,6 +95,7 @@ BrickPass march_brick(RedistanceDomain& w, std::uint32_t b, const BrickMask& fre
       m.val[t] = v;
     } else if (own) {
       if (free_mask.test(n)) s |= kFreeBit;
+      m.cap[t] = cap != nullptr ? std::min(limit, cap[n]) : limit;
     } else if (v <= limit) {
       s |= kKnownBit;
       m.val[t] = v;
@@ -103,7 +106,7 @@ BrickPass march_brick(RedistanceDomain& w, std::uint32_t b, const BrickMask& fre
   for_each_halo_voxel<Halo>(w.nbr[b], [&](std::uint32_t nb, int n, int t) { put(nb, n, t, false); });
   // A better tentative value v for free voxel t.
   auto offer = [&](int t, float v) {
-    if (!(v < m.val[t]) || !(v <= limit)) return;
+    if (!(v < m.val[t]) || !(v <= m.cap[t])) return;
     m.val[t] = v;
     const std::uint64_t k = trial_key(v, t);
     if (m.st[t] & kTrialBit) {

@@ -419,6 +419,13 @@ class Membranes {
         });
       }
     });
+    // Only voxels where the membrane may end up nearer than the mesh need its distance: a
+    // voxel accepted farther than its mesh distance plus kMembraneMargin passes nothing on
+    // (membrane_band.hpp).
+    w.cap.resize(nd * kBrickVoxels);
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, nd * kBrickVoxels, 1 << 14), [&](const auto& r) {
+      for (std::size_t i = r.begin(); i != r.end(); ++i) w.cap[i] = float(double(dmesh[i]) / h) + kMembraneMargin;
+    });
     detail::march(w, 1, o_.frame.half_width, 1e-6f, o_.progress);
     merge(w, dmesh, h);
   }

@@ -7,7 +7,64 @@
 
 namespace levelset::scan_detail {
 
-void Scanner::scan(const Polyhedron& p, std::uint32_t tri, const Vec3d& n, double plane_margin) {
+namespace {
+
+// The squared distance to the feature.
+template <FeatureBound::Kind Kind>
+inline double feature_distance2(const FeatureBound& f, const Vec3d& x) {
+  const Vec3d q = x - f.origin;
+  const double q2 = dot(q, q);
+  if constexpr (Kind == FeatureBound::Kind::point) return q2;
+  const double along = dot(q, f.axis);
+  return q2 - along * along;
+}
+
+// Narrows a column's interval [t0, t1] along axis k (at (xu, xv) across it) to the points
+// within `reach` of the feature, a superset of those the per-voxel bound keeps; false when
+// none is left. The solid is a ball about the point or a cylinder about the line: a
+// quadratic along the column.
+template <FeatureBound::Kind Kind>
+inline bool clip_column(const FeatureBound& f, double reach, int k, int u, int v, double xu, double xv, double& t0,
+                        double& t1) {
+  if constexpr (Kind == FeatureBound::Kind::none) return true;
+  const double qu = xu - f.origin[u], qv = xv - f.origin[v], ok = f.origin[k];
+  const double r2 = reach * reach;
+  if constexpr (Kind == FeatureBound::Kind::point) {
+    const double across = r2 - qu * qu - qv * qv;
+    if (across < 0) return false;
+    const double s = std::sqrt(across);
+    t0 = std::max(t0, ok - s);
+    t1 = std::min(t1, ok + s);
+    return t0 <= t1;
+  }
+  // |q|^2 - (q . a)^2 <= r2 with q = (qu, qv, s) in (u, v, k), s = t - ok: A s^2 + B s + C <= 0.
+  const Vec3d& a = f.axis;
+  const double qa = qu * a[u] + qv * a[v];  // q . a at s = 0
+  const double A = 1.0 - a[k] * a[k], B = -2.0 * qa * a[k], C = qu * qu + qv * qv - qa * qa - r2;
+  if (A < 1e-6) return C <= 1e-6 * r2;  // a line along the column: nearly constant distance
+  const double disc = B * B - 4.0 * A * C;
+  if (disc < 0) return false;
+  const double root = std::sqrt(disc);
+  t0 = std::max(t0, ok + (-B - root) / (2.0 * A));
+  t1 = std::min(t1, ok + (-B + root) / (2.0 * A));
+  return t0 <= t1;
+}
+
+}  // namespace
+
+void Scanner::scan(const Polyhedron& p, std::uint32_t tri, const Vec3d& n, double plane_margin,
+                   const FeatureBound& feature) {
+  // One loop per kind: the plain scan keeps its inner loop free of the bound's tests.
+  switch (feature.kind) {
+    case FeatureBound::Kind::none: return scan_with<FeatureBound::Kind::none>(p, tri, n, plane_margin, feature);
+    case FeatureBound::Kind::point: return scan_with<FeatureBound::Kind::point>(p, tri, n, plane_margin, feature);
+    case FeatureBound::Kind::line: return scan_with<FeatureBound::Kind::line>(p, tri, n, plane_margin, feature);
+  }
+}
+
+template <FeatureBound::Kind Kind>
+void Scanner::scan_with(const Polyhedron& p, std::uint32_t tri, const Vec3d& n, double plane_margin,
+                        const FeatureBound& feature) {
   ++polyhedra;
   int lo[3], hi[3];
   for (int a = 0; a < 3; ++a) {
@@ -38,11 +95,15 @@ void Scanner::scan(const Polyhedron& p, std::uint32_t tri, const Vec3d& n, doubl
       par_c[npar] = p.c[i], par_u[npar] = p.g[i][u], par_v[npar++] = p.g[i][v];
     }
   }
+  // The feature's solid that the per-voxel bound below can keep at all, with room to spare
+  // (one voxel: the column clip is only a shortcut, the per-voxel test decides).
+  const double feature_reach = (r_ + feature.margin) * (1.0 + 1e-5) + h_;
   for (int jv = lo[v]; jv <= hi[v]; ++jv) {
     const double xv = frame_.origin[v] + jv * h_;
     for (int ju = lo[u]; ju <= hi[u]; ++ju) {
       const double xu = frame_.origin[u] + ju * h_;
       double t0 = frame_.origin[k] + lo[k] * h_, t1 = frame_.origin[k] + hi[k] * h_;
+      if (!clip_column<Kind>(feature, feature_reach, k, u, v, xu, xv, t0, t1)) continue;
       bool cut = false;
       for (int i = 0; i < npar; ++i) cut |= par_c[i] - par_u[i] * xu - par_v[i] * xv < 0;
       for (int i = 0; i < nup; ++i) t1 = std::min(t1, (up_c[i] - up_u[i] * xu - up_v[i] * xv) * up_inv[i]);
@@ -63,7 +124,13 @@ void Scanner::scan(const Polyhedron& p, std::uint32_t tri, const Vec3d& n, doubl
         if (cell == kNoCell) continue;
         // A lower bound, also under the rounding of the distance itself (relative margin).
         const double plane = std::abs(dot(n, x - ta)) * (1.0 - 1e-6) - plane_margin;
-        if (plane > r_ || plane > double(field_.best(cell))) continue;
+        const double best = double(field_.best(cell));
+        if (plane > r_ || plane > best) continue;
+        if constexpr (Kind != FeatureBound::Kind::none) {
+          // sqrt(d2) (1 - 1e-6) - margin > min(best, r), squared (both sides >= 0).
+          const double reach = std::min(best, r_) + feature.margin;
+          if (feature_distance2<Kind>(feature, x) * (1.0 - 2e-6) > reach * reach) continue;
+        }
         const double d2 = closest_point_on_triangle(x, ta, tb, tc).distance_squared;
         ++evaluations;
         if (!(d2 <= band2_)) continue;

@@ -98,6 +98,19 @@ class MinField {
   mutable UninitializedVector<std::uint64_t> cells_;  // accessed through atomic_ref once filled
 };
 
+// A lower bound of the distance to the scanned triangle inside a polyhedron, sharper than its
+// plane's in the wedges and cones: the distance to the feature the polyhedron belongs to, a
+// vertex (point) or an edge's line, less `margin`. In a vertex's cone the triangle's closest
+// point is the vertex, in an edge's wedge a point of the edge; the polyhedra's slack lets in
+// points a little nearer the triangle than the feature, which the margin covers. Overlapping
+// wedges and cones (across holes, beyond borders, in concave corners and thin plates, where
+// several features lie within W h) are then skipped where a nearer triangle is known.
+struct FeatureBound {
+  enum class Kind { none, point, line } kind = Kind::none;
+  Vec3d origin, axis;  // the vertex, or a point of the edge's line and its unit direction
+  double margin = 0;
+};
+
 class Scanner {
  public:
   Scanner(const TriangleMesh& mesh, MinField& field, const GridFrame& frame)
@@ -114,9 +127,14 @@ class Scanner {
   // plane_margin (TriangleFrame), already exceeds their best distance (overlapping
   // polyhedra, common where the band is wider than the surface's radius of curvature) are
   // skipped: that bounds the distance from below, so they could not win.
-  void scan(const Polyhedron& p, std::uint32_t tri, const Vec3d& n, double plane_margin);
+  // `feature` (optional) adds FeatureBound's lower bound to the plane's.
+  void scan(const Polyhedron& p, std::uint32_t tri, const Vec3d& n, double plane_margin,
+            const FeatureBound& feature = {});
 
  private:
+  template <FeatureBound::Kind Kind>
+  void scan_with(const Polyhedron& p, std::uint32_t tri, const Vec3d& n, double plane_margin,
+                 const FeatureBound& feature);
   static constexpr std::size_t kNoCell = ~std::size_t{0};
   std::size_t cell_of(const Coord& voxel) {
     const Coord b = brick_of(voxel);

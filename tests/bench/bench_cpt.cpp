@@ -4,8 +4,10 @@
 // voxel counts, then one summary line per kind (coarse, dense): the worst ratio.
 // Columns: ours (the default: the characteristic scan, or the slab scan where it is estimated
 //   cheaper: "method"), OpenVDB, the slab scan alone on the coarse rows and the sphere (0 where
-//   not run; one run), the ratio ours / OpenVDB. Times are the best of 3 runs (the dense rows'
-//   single runs swung by 10 % between two runs of the bench on a busy machine).
+//   not run; one run), the ratio ours / OpenVDB, both bands' active voxels, and our fastest
+//   run's phases (bin / distance / sign / membrane seconds; the sign mesh's orientation runs
+//   beside bin and distance). Times are the best of 3 runs (the dense rows' single runs swung
+//   by 10 % between two runs of the bench on a busy machine).
 // Rows: coarse CGAL meshes (knot, bunny) at R = 256 and 512, W = 3, 6, 12; dense meshes, where
 //   there is about one triangle per surface voxel as in scans and meshes extracted from grids:
 //   a marching-cubes sphere at R = 256 (588k triangles) and every CGAL mesh subdivided until
@@ -57,11 +59,14 @@ bool bench_row(const Row& row, bench::RatioSummary& summary) {
   std::uint64_t ours_active = 0, vdb_active = 0;
   CptMethod method = CptMethod::automatic;
   bool open = false;
+  CptTimings phases;  // of the fastest run
+  double fastest = 1e300;
   const double ours = bench::best_of(row.runs, [&] {
     const CptResult r = closest_point_transform(*row.mesh, options);
     ours_active = r.band.active_voxel_count();
     method = r.method;
     open = r.open_edges > 0;
+    if (r.seconds.total < fastest) fastest = r.seconds.total, phases = r.seconds;
   });
   // The slab scan on the same row (the method before the characteristic scan), where it takes
   // less than a minute: its W^3 work per triangle is what the characteristic scan removes.
@@ -80,10 +85,14 @@ bool bench_row(const Row& row, bench::RatioSummary& summary) {
   char label[160];
   std::snprintf(label, sizeof label, "%s R=%d W=%g thr=%d", row.name.c_str(), row.resolution, row.half_width,
                 row.threads);
-  std::printf("%-24s %8zu %5d %4g %3d %6s %9.3f %9.3f %9.3f %7.3fx %10llu %10llu%s\n", row.name.c_str(),
+  // Phases of our fastest run (orient runs beside bin + distance; sign waits for it).
+  char split[96];
+  std::snprintf(split, sizeof split, "%.3f/%.3f/%.3f/%.3f", phases.bin, phases.distance, phases.sign,
+                phases.membrane);
+  std::printf("%-24s %8zu %5d %4g %3d %6s %9.3f %9.3f %9.3f %7.3fx %10llu %10llu %-27s%s\n", row.name.c_str(),
               row.mesh->triangles.size(), row.resolution, row.half_width, row.threads,
               method == CptMethod::slab_scan ? "slab" : "charac", ours, vdb, slab, ours / vdb,
-              (unsigned long long)ours_active, (unsigned long long)vdb_active, open ? "  open" : "");
+              (unsigned long long)ours_active, (unsigned long long)vdb_active, split, open ? "  open" : "");
   std::fflush(stdout);
   if (row.threads == 2) {
     // Open meshes: our sign is the winding number's with the holes' membranes (OpenVDB's a
@@ -133,8 +142,8 @@ int main(int argc, char** argv) {
   const std::string data = std::string(LEVELSET_CGAL_DATA) + "/meshes/";
   std::printf("bench_cpt: closest point transform vs OpenVDB %s meshToLevelSet\n",
               openvdb::getLibraryAbiVersionString());
-  std::printf("%-24s %8s %5s %4s %3s %6s %9s %9s %9s %8s %10s %10s\n", "mesh", "tris", "R", "W", "thr", "method",
-              "ours_s", "vdb_s", "slab_s", "ratio", "our_active", "vdb_active");
+  std::printf("%-24s %8s %5s %4s %3s %6s %9s %9s %9s %8s %10s %10s %-27s\n", "mesh", "tris", "R", "W", "thr", "method",
+              "ours_s", "vdb_s", "slab_s", "ratio", "our_active", "vdb_active", "bin/distance/sign/membrane");
   bench::RatioSummary summary("bench_cpt");
   return bench::run_bench("bench_cpt", nullptr, [&] {
     bool ok = true;

@@ -1,8 +1,9 @@
 // The characteristic scan (CptMethod::characteristic: prisms, wedges and cones) against the slab
 // scan (CptMethod::slab_scan, which the brute-force tests in test_closest_point_transform also
 // check): the same band and values within 1e-5 h on every CGAL mesh at W = 3, 6 and 12, on meshes
-// subdivided until there is about one triangle per surface voxel, and on separate sheets whose
-// polyhedra overlap; the same result for any thread count.
+// subdivided until there is about one triangle per surface voxel, on separate sheets whose
+// polyhedra overlap, and on open sheets whose wide wedges and cones overlap at W = 12; the same
+// result for any thread count.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -153,6 +154,32 @@ TEST(CharacteristicScan, SeparateSheetsAndThinParts) {
   for (const double w : {2.0, 4.0})
     expect_same("double-sided sheet W=" + std::to_string(int(w)),
                 compare_methods(sheet, frame_for_resolution(sheet.bounds(), 64, w)));
+}
+
+// Open sheets in a wide band: every border edge's wedge is a half-cylinder and every border or
+// corner vertex's cone a large part of the ball around it, and across holes and between
+// nearby pieces they overlap many times over, where the scan skips the voxels a wedge's line
+// or a cone's vertex is already farther from than a known triangle (FeatureBound). A soup of
+// small separate triangles (all wedges and cones wide), and CGAL's open meshes with holes,
+// borders and many components.
+TEST(CharacteristicScan, OverlappingWideWedgesAndConesOfOpenSheets) {
+  TriangleMesh soup;
+  std::uint32_t seed = 12345;
+  auto next = [&] {  // a fixed linear congruential sequence in [0, 1)
+    seed = seed * 1664525u + 1013904223u;
+    return double(seed >> 8) / double(1u << 24);
+  };
+  for (int i = 0; i < 120; ++i) {
+    const Vec3d c{next(), next(), next()};
+    for (int k = 0; k < 3; ++k) soup.vertices.push_back(c + Vec3d{next(), next(), next()} * 0.08);
+    const std::uint32_t b = std::uint32_t(3 * i);
+    soup.triangles.push_back({b, b + 1, b + 2});
+  }
+  expect_same("soup of 120 small triangles W=12", compare_methods(soup, frame_for_resolution(soup.bounds(), 64, 12.0)));
+  for (const char* name : {"elephant-with-holes.off", "b9_mesh.off", "mask_cone.off"})
+    expect_same(std::string(name) + " W=12",
+                compare_methods(test::load_cgal_mesh(name),
+                                frame_for_resolution(test::load_cgal_mesh(name).bounds(), 64, 12.0)));
 }
 
 // Degenerate faces alone on a slanted line (no flat face's edge covers it), overlapping many
