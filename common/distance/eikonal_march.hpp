@@ -7,7 +7,10 @@
 //   other voxels hold kInf; order 1 or 2 as in sweep(); limit = the half-width in voxels;
 //   tolerance in voxels.
 //   Output: w.dist of every free domain voxel reached with a value <= limit holds its
-//   unsigned distance in voxels; the others stay kInf. Returns the rounds run.
+//   unsigned distance in voxels; the others stay kInf. Returns the rounds run. With w.cap
+//   (optional, per voxel) a free voxel is accepted only up to min(limit, its cap), and one
+//   left unknown passes nothing on (close_membranes: no membrane distance beyond where the
+//   mesh is nearer).
 //   Each brick marches on a tile with its face neighbours' current values (1 voxel deep, 2
 //   for second order) as boundary data: its free voxels are recomputed from scratch, the
 //   smallest tentative value accepted first (ties by tile index) and fixed when accepted,

@@ -14,6 +14,8 @@
 #include "core/error.hpp"
 #include "distance/eikonal_march.hpp"
 #include "distance/eikonal_trial_heap.hpp"
+#include "distance/interface_init.hpp"
+#include "distance/redistance_domain.hpp"
 #include "distance/redistance.hpp"
 #include "grid/band_accessor.hpp"
 #include "grid/band_builder.hpp"
@@ -428,6 +430,44 @@ TEST(RedistanceMethods, MarchRoundsConvergeOnAWideBand) {
   EXPECT_LT(d.max_diff, 1e-5);
   EXPECT_LE(d.only_one, s.band.active_voxel_count() / 10000);
   EXPECT_GT(s.band.active_voxel_count(), 3 * in.active_voxel_count());
+}
+
+// The march's per-voxel caps (RedistanceDomain::cap, the membranes' use): a voxel is accepted
+// only up to its cap and then passes nothing on. With one cap c everywhere, every value up to
+// c is computed from smaller ones only, so it equals the uncapped march's bit for bit, and
+// every voxel the uncapped march put beyond c stays unknown; with caps that vary, a value
+// can only grow (fewer upwind voxels), never shrink.
+TEST(RedistanceMethods, MarchCapsStopVoxelsAtTheirCap) {
+  const auto sb = make_shape_band("torus", 64);
+  const NarrowBand in = distort(sb.band);
+  auto march = [&](float cap, bool varying) {
+    detail::RedistanceDomain w = detail::build_domain(in, 3, {});
+    detail::init_interface(in, w);
+    w.cap.assign(w.size() * kBrickVoxels, cap);
+    if (varying)
+      for (std::size_t i = 0; i < w.cap.size(); i += 3) w.cap[i] = 1.0f;  // every third voxel
+    detail::march(w, 1, 6.0, 1e-6f, {});
+    return std::vector<float>(w.dist.begin(), w.dist.end());
+  };
+  const std::vector<float> free = march(1e30f, false), capped = march(2.5f, false), varying = march(3.5f, true);
+  ASSERT_EQ(free.size(), capped.size());
+  std::size_t kept = 0, stopped = 0, grown = 0;
+  for (std::size_t i = 0; i < free.size(); ++i) {
+    if (free[i] <= 2.5f) {
+      EXPECT_EQ(capped[i], free[i]) << i;
+      ++kept;
+    } else {
+      EXPECT_EQ(capped[i], detail::kInf) << i;
+      stopped += free[i] <= 6.0f;
+    }
+    if (varying[i] < detail::kInf) {
+      EXPECT_GE(varying[i], free[i]) << i;
+    }
+    grown += varying[i] > free[i] && free[i] <= 3.5f;
+  }
+  EXPECT_GT(kept, 10000u);
+  EXPECT_GT(stopped, 10000u);
+  EXPECT_GT(grown, 100u);
 }
 
 // The iteration cap and the tolerance: one iteration leaves work undone; tolerance 0 runs
