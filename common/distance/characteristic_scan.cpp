@@ -24,12 +24,12 @@ namespace {
 
 using namespace scan_detail;
 
-// The box of p0 + R d over a 2D cone of unit directions (between d1 and d2 through mid, angle
-// with cosine cos_theta) and both edge ends, or the whole cylinder's box when the cone is wide.
 // Wedges opening wider than this (cosine of the opening; 120 degrees) are scanned over the
 // cylinder's box.
 constexpr double kWideCos = -0.5;
 
+// The box of p0 + R d over a 2D cone of unit directions (between d1 and d2 through mid, angle
+// with cosine cos_theta) and both edge ends, or the whole cylinder's box when the cone is wide.
 void wedge_box(Polyhedron& p, const Vec3d& p0, const Vec3d& p1, const Vec3d& d1, const Vec3d& d2, const Vec3d& mid,
                double cos_theta, double r) {
   if (cos_theta < kWideCos) {  // the cylinder's box

@@ -46,7 +46,7 @@ struct RedistanceDomain {
   UninitializedVector<float> dist;                // 512 per brick; +inf = unknown (filled in parallel)
   // Optional (march only): 512 per brick, a free voxel's value is accepted only up to its cap
   // (voxels; beyond it the voxel stays unknown and passes nothing on). Empty: the limit alone.
-  std::vector<float> cap;
+  UninitializedVector<float> cap;  // (filled in parallel)
 
   std::size_t size() const { return coords.size(); }
   float* values(std::uint32_t b) { return dist.data() + std::size_t(b) * kBrickVoxels; }
