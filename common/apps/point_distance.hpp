@@ -117,10 +117,12 @@ LocalFit local_fit(const PointIndex& index, const Vec3d& x, int k);
 // marching-cubes topology followed the noise). Thread-safe.
 LocalFit one_sided_fit(const PointIndex& index, const Vec3d& x, const Vec3d& n, int k, double min_band);
 
-// How the height fit treats the points' noise (sheet_fit). sigma (world, per axis; 0: none
-// assumed): the points' tangential coordinates carry it too, which biases a regressed height by
-// sigma^2 / 2 times the surface's Laplacian (a curved patch's fit lies toward its concave side by
-// ~H sigma^2, H the mean curvature); c0 is corrected by that, at most by sigma / 2. select: the
+// How the height fit treats the points' noise (sheet_fit). sigma (world, per axis, isotropic; 0:
+// none assumed): a curved patch's regressed height lies toward its concave side by about
+// 2 kappa sigma^2 (kappa the half mean curvature: one kappa sigma^2 through the noise in the
+// tangential coordinates, about one more through the choice of the nearest points, whose rim
+// keeps the points the noise moved toward the tangent plane); c0 is corrected by a multiple of
+// the fitted kappa sigma^2 (point_distance.cpp correct_for_noise), at most by sigma / 2. select: the
 // height fit's points are chosen without a bias toward the tangent plane: the band is at least
 // 3 sigma, and the points lie in a tangential disc the k_height ball holds whole (a ball cuts the
 // slab's corners, so it keeps a curved patch's rim points by their height). The scale choice's
@@ -187,6 +189,7 @@ struct SheetModel {
   bool has_height = false;
   std::array<double, 6> c{};  // z = c0 + c1 u + c2 v + c3 u^2 + c4 u v + c5 v^2, (u, v) = (xi, eta) * inv_r
   double inv_r = 0.0;
+  double noise_curvature = 0.0;  // the noise correction's c0 shift per sigma^2 (world^-1; 0 without noise)
   double height_residual = 0.0;
   double patch_radius() const { return inv_r > 0.0 ? 1.0 / inv_r : 0.0; }
   SheetFit at(const Vec3d& y) const;

@@ -95,7 +95,12 @@
 //   snap), valid because the upsampled coarse front lies within about a voxel of the data.
 //   Passes (snap_passes per level; on the final level at least clean_final_passes when the
 //   first pass found the data clean: the second pass refits along the corrected normals)
-//   stop early when the mean |change| of the snapped voxels is below tolerance.
+//   stop early when the mean |change| of the snapped voxels is below tolerance. A level's
+//   first pass may run before any level has read the noise; where its reading asks for 4 times
+//   the height fits' points or more, the final level, and a level whose fits read more noise
+//   than 0.7 final voxels, start again from the band before it
+//   (the few-point fits' noise would otherwise stay in the band: a pass moves each voxel by
+//   its neighbourhood's mean offset, which keeps the band's own high-frequency part).
 //   Output mesh: marching cubes of the final band (watertight by construction).
 // Output: ReconstructionResult (band in the input's world frame, mesh, measures, stages).
 // Cost: coarsest level O(steps * band) plus its fits; finer levels O(snap_passes * (voxels

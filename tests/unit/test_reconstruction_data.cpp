@@ -90,44 +90,15 @@ TEST(SheetFit, HeightResidualMeasuresNoiseNotCurvature) {
   EXPECT_NEAR(sum / n, sigma, 0.3 * sigma);
 }
 
-// Noise in the points' tangential coordinates biases a regressed height toward the concave
-// side: on the parabolic cylinder z = -x^2 / (2 r), points sampled at x_t and seen at x_t + e
-// (e ~ N(0, sigma^2), no noise in z) have E[z | x] = -(x^2 + sigma^2) / (2 r), so the fit's
-// surface sinks by sigma^2 / (2 r). Given the noise, sheet_fit corrects for it: the mean height
-// offset at points of the true surface is then zero within a quarter of that bias.
-TEST(SheetFit, TangentialNoiseDoesNotSinkACurvedSurface) {
-  const double r = 0.25, sigma = 0.02, bias = sigma * sigma / (2.0 * r);
-  std::mt19937_64 rng(11);
-  std::uniform_real_distribution<double> u(-1.0, 1.0);
-  std::normal_distribution<double> g(0.0, sigma);
-  std::vector<Vec3d> points(40000);
-  for (Vec3d& p : points) {
-    const double x = u(rng);
-    p = {x + g(rng), u(rng), -x * x / (2.0 * r)};
-  }
-  const PointIndex index(points);
-  auto mean_offset = [&](double noise) {
-    double sum = 0.0;
-    int n = 0;
-    for (double y = -0.5; y <= 0.5; y += 0.02) {  // x = 0: the frame is the cylinder's own
-      const SheetFit f = sheet_fit(index, {0.0, y, 0.0}, {0, 0, 1}, 8, 200, 1.0, HeightNoise{noise, false});
-      EXPECT_TRUE(f.has_height);
-      sum += f.height_offset;  // > 0: the fitted surface lies below the point
-      ++n;
-    }
-    return sum / n;
-  };
-  EXPECT_NEAR(mean_offset(0.0), bias, 0.2 * bias);
-  EXPECT_NEAR(mean_offset(sigma), 0.0, 0.25 * bias);
-}
-
-// The same on scan-like data: a torus (radii 1 and 0.15) sampled by area with isotropic noise
-// of 0.5 % of its box's diagonal, fitted over 165 points (what the reconstruction's final
-// level takes there). Besides the tangential noise, the point selection lifts the patch's rim
-// (a 3D ball and a flat slab both keep the rim's points nearest the tangent plane): without
-// the noise the fits at points of the true surface lie 0.09 sigma inside on average and their
-// residual reads 0.89 sigma; with the correction alone 0.06 sigma and 0.89; with the selection
-// for noise as well, 0.01 sigma and 1.01 sigma.
+// Noise biases a curved patch's height fit toward its concave side (tests/unit/
+// test_sheet_fit_noise.cpp); here on scan-like data: a torus (radii 1 and 0.15) sampled by
+// area with isotropic noise of 0.5 % of its box's diagonal, fitted over 165 points (what the
+// reconstruction's final level takes there). Uncorrected, the fits at points of the true
+// surface lie 0.094 sigma inside on average and their residual reads 0.89 sigma (the 3D ball
+// and the flat slab keep the rim's points nearest the tangent plane); corrected, -0.013 sigma
+// with the ball's points, -0.022 sigma with the selection for noise, whose residual reads
+// 1.01 sigma. (The tangential term alone, the correction before, left 0.059 sigma with the
+// ball's points.)
 TEST(SheetFit, NoisyTubeFitsAreNotSunk) {
   const double R = 1.0, r = 0.15;
   const double sigma = 0.005 * std::sqrt(2.0 * 4.0 * (R + r) * (R + r) + 4.0 * r * r);
@@ -155,10 +126,9 @@ TEST(SheetFit, NoisyTubeFitsAreNotSunk) {
   const auto [offset, residual] = mean_fit({sigma, true});
   EXPECT_GT(sunk, 0.07);
   EXPECT_LT(read_low, 0.93);
-  EXPECT_LT(corrected, sunk - 0.02);  // the correction alone: about 0.04 sigma less
-  EXPECT_LT(still_low, 0.93);         // the selection is what lets the residual read the noise
+  EXPECT_LT(std::abs(corrected), 0.03);
+  EXPECT_LT(still_low, 0.93);  // the selection is what lets the residual read the noise
   EXPECT_LT(std::abs(offset), 0.03);
-  EXPECT_LT(offset, corrected - 0.02);
   EXPECT_NEAR(residual, 1.0, 0.06);
 }
 
