@@ -514,6 +514,48 @@ SnapPass snap_to_fits(NarrowBand& band, const PointIndex& index, const SnapSetti
   return pass;
 }
 
+// The settings of a snap pass on `band` (voxel size h) from the noise the previous pass read
+// (final voxels): the height fits' point count and noise model (see kNoisyHeightNeighbors,
+// kSoftScaleGrowth), their guard against the plane fits, and the window.
+SnapSettings snap_settings(const ReconstructionOptions& o, const NarrowBand& band, std::size_t points,
+                           SnapNoise previous, double h, double h_final, bool refine) {
+  const double previous_noise = previous.noise, previous_height_noise = previous.height_noise;
+  SnapSettings settings;
+  settings.neighbors = o.neighbors;
+  // Noise between kSoftScaleMinNoise and the reference: the fits take kSoftScaleGrowth
+  // times the count law's points and choose the patch by the soft three-scale rule
+  // (sheet_fit's HeightNoise::soft).
+  settings.soft_scales = previous_height_noise >= kSoftScaleMinNoise && previous_height_noise <= kReferenceNoise;
+  const int growth = settings.soft_scales ? kSoftScaleGrowth : 1;
+  settings.height_neighbors = std::max(o.neighbors, kHeightNeighbors);
+  if (previous_noise >= kCleanNoise) {
+    settings.noisy_height = true;
+    settings.height_neighbors =
+        std::max(settings.height_neighbors,
+                 std::min(256, growth * noisy_height_neighbors(band, points, h_final, previous_height_noise)));
+  } else if (previous_height_noise > 0.0) {  // clean so far: more points as the noise grows
+    settings.height_neighbors = std::max(
+        settings.height_neighbors, height_neighbors_for(front_density(band, points, h_final), previous_height_noise, growth));
+  }
+  settings.height_guard = std::max(kHeightGuard, kHeightGuardNoise * previous_height_noise * h_final / h);
+  settings.noise = std::sqrt(std::max(0.0, previous_height_noise * previous_height_noise -
+                                               kResidualFloor * kResidualFloor)) * h_final;
+  settings.window = refine ? kRefineWindow : kSnapWindow;
+  settings.fit_window = refine ? kRefineWindow : kFitWindow;
+  settings.h_final = h_final;
+  settings.guard = o.guard_snaps;
+  return settings;
+}
+
+// The band redistanced (fast sweeping, half-width W) on its domain less `shrink` voxels
+// (snap_level: the domain may grow by the front's motion since the last redistance).
+NarrowBand redistanced(const NarrowBand& band, double W, double shrink, const ProgressHook& progress) {
+  RedistanceOptions redo;
+  redo.half_width = W;
+  redo.progress = progress;
+  return redistance(reframed(band, {}, W - shrink), redo).band;
+}
+
 }  // namespace
 
 SnapOutput snap_level(NarrowBand band, const PointIndex& index, const ReconstructionOptions& o,
@@ -539,32 +581,7 @@ SnapOutput snap_level(NarrowBand band, const PointIndex& index, const Reconstruc
   }
   stage.seconds_start += seconds_since(t_up);
   auto settings_for = [&](bool refine) {
-    SnapSettings settings;
-    settings.neighbors = o.neighbors;
-    // Noise between kSoftScaleMinNoise and the reference: the fits take kSoftScaleGrowth
-    // times the count law's points and choose the patch by the soft three-scale rule
-    // (sheet_fit's HeightNoise::soft).
-    settings.soft_scales = previous_height_noise >= kSoftScaleMinNoise && previous_height_noise <= kReferenceNoise;
-    const int growth = settings.soft_scales ? kSoftScaleGrowth : 1;
-    settings.height_neighbors = std::max(o.neighbors, kHeightNeighbors);
-    if (previous_noise >= kCleanNoise) {
-      settings.noisy_height = true;
-      settings.height_neighbors =
-          std::max(settings.height_neighbors,
-                   std::min(256, growth * noisy_height_neighbors(band, index.size(), h_final, previous_height_noise)));
-    } else if (previous_height_noise > 0.0) {  // clean so far: more points as the noise grows
-      settings.height_neighbors = std::max(settings.height_neighbors,
-                                           height_neighbors_for(front_density(band, index.size(), h_final),
-                                                                previous_height_noise, growth));
-    }
-    settings.height_guard = std::max(kHeightGuard, kHeightGuardNoise * previous_height_noise * h_final / h);
-    settings.noise = std::sqrt(std::max(0.0, previous_height_noise * previous_height_noise -
-                                                 kResidualFloor * kResidualFloor)) * h_final;
-    settings.window = refine ? kRefineWindow : kSnapWindow;
-    settings.fit_window = refine ? kRefineWindow : kFitWindow;
-    settings.h_final = h_final;
-    settings.guard = o.guard_snaps;
-    return settings;
+    return snap_settings(o, band, index.size(), {previous_noise, previous_height_noise}, h, h_final, refine);
   };
   for (int pass = 0; !carved_bricks.empty() && pass < kPassesAfterCarving; ++pass) {
     const auto t_fit = Clock::now();
@@ -575,10 +592,7 @@ SnapOutput snap_level(NarrowBand band, const PointIndex& index, const Reconstruc
     stage.fit_voxels += snapped.voxels;
     stage.seconds_fit += seconds_since(t_fit);
     const auto t_redistance = Clock::now();
-    RedistanceOptions redo;
-    redo.half_width = W;
-    redo.progress = o.progress;
-    band = redistance(reframed(band, {}, W - 1.0), redo).band;
+    band = redistanced(band, W, 1.0, o.progress);
     stage.seconds_redistance += seconds_since(t_redistance);
   }
   // On the final level, clean data get clean_final_passes (the first pass's noise
@@ -639,10 +653,7 @@ SnapOutput snap_level(NarrowBand band, const PointIndex& index, const Reconstruc
     const bool last = pass + 1 == passes || stage.last_change < o.tolerance;
     if (last || !snapped.clean || double(unredistanced) + 1.0 >= W) {  // the domain may grow W - 1 voxels at most
       const auto t_redistance = Clock::now();
-      RedistanceOptions redo;
-      redo.half_width = W;
-      redo.progress = o.progress;
-      band = redistance(reframed(band, {}, W - double(unredistanced)), redo).band;
+      band = redistanced(band, W, double(unredistanced), o.progress);
       unredistanced = 0;
       stage.seconds_redistance += seconds_since(t_redistance);
     }
