@@ -614,12 +614,13 @@ SnapOutput snap_level(NarrowBand band, const PointIndex& index, const Reconstruc
   NarrowBand before_first;
   for (int pass = 0; pass < passes; ++pass) {
     const auto t_fit = Clock::now();
-    if (pass == 0 && !restarted) before_first = band;
+    // (Only a pass whose fits could still grow by kRestartGrowth can restart.)
+    if (pass == 0 && !restarted && kRestartGrowth * settings_for(refine).height_neighbors <= 256) before_first = band;
     const SnapSettings settings = settings_for(refine);
     const SnapPass snapped = snap_to_fits(band, index, settings, coarse, coarse_curvature, o.progress);
     previous_noise = snapped.noise * h / h_final;
     previous_height_noise = snapped.height_noise * h / h_final;
-    if (pass == 0 && !restarted && (level == levels - 1 || previous_height_noise > kReferenceNoise) &&
+    if (pass == 0 && !restarted && before_first.active_voxel_count() > 0 && (level == levels - 1 || previous_height_noise > kReferenceNoise) &&
         settings_for(false).height_neighbors >= kRestartGrowth * settings.height_neighbors) {
       band = std::move(before_first);
       restarted = true;
