@@ -463,11 +463,12 @@ int height_points(const PointIndex& index, const Vec3d& x, const Vec3d& n, const
 struct ScaledFit {
   HeightFit fit;
   double variance = 0.0;
+  double large_weight = 1.0;  // the weight of the largest patch's fit in `fit`
 };
 
 ScaledFit with_variance(const HeightFit& f) {
   const double se = f.residual * f.spread;
-  return {f, se * se};
+  return {f, se * se, 1.0};
 }
 
 // The estimate `large` shrunk toward `smaller` (a fit over the nearer part of the same points):
@@ -480,6 +481,7 @@ ScaledFit blend_scales(const ScaledFit& large, const ScaledFit& smaller) {
   const double dv = std::max(0.0, smaller.variance - large.variance), d = a.offset - b.offset;
   const double w = d * d <= dv ? 1.0 : dv / (d * d);
   ScaledFit out = large;
+  out.large_weight = w * large.large_weight;
   // Coefficient i is in units of inv_r^degree (c0: world; c1, c2: degree 1; c3..c5: degree 2):
   // the smaller fit's, in the large one's units, are scaled by (inv_r_small / inv_r_large)^degree.
   const double q = b.inv_r / a.inv_r;
@@ -497,17 +499,17 @@ ScaledFit blend_scales(const ScaledFit& large, const ScaledFit& smaller) {
 // toward the fit over the nearer half, that toward the fit over the nearer quarter
 // (blend_scales), each scale at least kSmallPatch points. `large` is the fit over all of them
 // with its spread (returned where the smaller scales do not fit).
-HeightFit soft_scale_choice(const TangentPoint* pts, int used, const HeightFit& large) {
+ScaledFit soft_scale_choice(const TangentPoint* pts, int used, const HeightFit& large) {
   const int half = std::max(kSmallPatch, used / 2), quarter = std::max(kSmallPatch, used / 4);
-  if (used < 2 * half) return large;
+  if (used < 2 * half) return {large, 0.0, 1.0};
   const HeightFit medium = quadric_height<true>(pts, half);
-  if (!medium.ok) return large;
+  if (!medium.ok) return {large, 0.0, 1.0};
   ScaledFit out = blend_scales(with_variance(large), with_variance(medium));
   if (half >= 2 * quarter) {
     const HeightFit small = quadric_height<true>(pts, quarter);
     if (small.ok) out = blend_scales(out, with_variance(small));
   }
-  return out.fit;
+  return out;
 }
 
 // The quadric's coefficient of curvature c3 + c5 over R^2 (world^-1: half the mean curvature
@@ -568,11 +570,15 @@ SheetModel sheet_model_from(const PointIndex& index, const NearbyPoints* near, c
   // interval: then the small patch's (unbiased) offset is taken.
   const int small = std::max(kSmallPatch, used / kPatchRatio);
   if (noise.soft) {
-    fit = soft_scale_choice(pts.data(), used, fit);
+    const ScaledFit chosen = soft_scale_choice(pts.data(), used, fit);
+    fit = chosen.fit;
+    f.large_weight = chosen.large_weight;
   } else if (used >= 2 * small) {
     const HeightFit small_fit = quadric_height<true>(pts.data(), small);
-    if (small_fit.ok && std::abs(fit.offset - small_fit.offset) > kPatchConfidence * small_fit.residual * small_fit.spread)
+    if (small_fit.ok && std::abs(fit.offset - small_fit.offset) > kPatchConfidence * small_fit.residual * small_fit.spread) {
       fit = small_fit;
+      f.large_weight = 0.0;
+    }
   }
   const double kappa = half_mean_curvature(fit);
   const double factor = noise.select ? kNoiseBiasDisc : kNoiseBiasBall;
@@ -631,6 +637,12 @@ SheetFit sheet_fit(const NearbyPoints& near, const Vec3d& x, const Vec3d& n, int
 SheetModel sheet_model(const NearbyPoints& near, const Vec3d& x, const Vec3d& n, int k, int k_height,
                        double min_band, HeightNoise noise) {
   return sheet_model_from(near.index(), &near, x, n, k, k_height, min_band, noise);
+}
+
+LocalFit sheet_plane(const NearbyPoints& near, const Vec3d& x, const Vec3d& n, int k, double min_band) {
+  Sheet sh;
+  find_sheet(near.index(), &near, x, n, k, min_band, sh);
+  return sheet_moments(near.index(), x, sh, k);
 }
 
 PointFitFieldResult point_fit_field(const PointIndex& index, const NarrowBand& where,

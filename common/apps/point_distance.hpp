@@ -191,11 +191,17 @@ struct SheetModel {
   double inv_r = 0.0;
   double noise_curvature = 0.0;  // the noise correction's c0 shift per sigma^2 (world^-1; 0 without noise)
   double height_residual = 0.0;
+  // The weight of the fit over all the patch's points in the adopted one: 1 where the scale
+  // choice kept it, 0 where it took a smaller patch's, between where the soft choice blended
+  // (a patch bent by detail reads below 1).
+  double large_weight = 1.0;
   double patch_radius() const { return inv_r > 0.0 ? 1.0 / inv_r : 0.0; }
   SheetFit at(const Vec3d& y) const;
 };
 SheetModel sheet_model(const NearbyPoints& near, const Vec3d& x, const Vec3d& n, int k, int k_height, double min_band,
                        HeightNoise noise = {});
+// sheet_fit's plane part alone (its k nearest points only): bit for bit sheet_fit(...).plane.
+LocalFit sheet_plane(const NearbyPoints& near, const Vec3d& x, const Vec3d& n, int k, double min_band);
 
 struct PointFitFieldOptions {
   int neighbors = 8;  // k

@@ -90,7 +90,7 @@ std::string stage_line(const ReconstructionStage& stage) {
   std::snprintf(line, sizeof line,
                 "level %d: h %.4g, shell offset %.2f voxel, %s %d, change %.4f voxel, noise %.3f voxel (height fits %.3f), "
                 "%s (%d points), smoothing %d, %llu buried points, %d regions carved (%d pierced, %d webs cut, %llu voxels), %llu voxels, "
-                "%llu fits (%llu height); start %.3f s, "
+                "%llu fits (%llu height, %llu models); start %.3f s, "
                 "fits %.3f s, flow %.3f s, redistance %.3f s, total %.3f s",
                 stage.level, stage.voxel_size, stage.shell_offset, stage.level == 0 ? "flow steps" : "snap passes",
                 stage.steps, stage.last_change, stage.noise, stage.height_noise,
@@ -98,7 +98,8 @@ std::string stage_line(const ReconstructionStage& stage) {
                 static_cast<unsigned long long>(stage.buried_points), stage.carved_regions, stage.pierced_regions, stage.webs_cut,
                 static_cast<unsigned long long>(stage.carved_voxels),
                 static_cast<unsigned long long>(stage.active_voxels), static_cast<unsigned long long>(stage.fit_voxels),
-                static_cast<unsigned long long>(stage.height_fits), stage.seconds_start, stage.seconds_fit,
+                static_cast<unsigned long long>(stage.height_fits),
+                static_cast<unsigned long long>(stage.fit_models), stage.seconds_start, stage.seconds_fit,
                 stage.seconds_flow, stage.seconds_redistance, stage.seconds);
   return line;
 }

@@ -191,6 +191,7 @@ struct ReconstructionStage {
   std::uint64_t carved_voxels = 0;
   std::uint64_t active_voxels = 0;
   std::uint64_t fit_voxels = 0; // local fits computed (cache, or snapped voxels of all passes)
+  std::uint64_t fit_models = 0; // snap: sheet fits made for them (voxels of a column or block share one)
   double seconds = 0.0;         // whole level
   double seconds_start = 0.0;   // start shell, or upsampling
   double seconds_fit = 0.0;     // fits (the snap passes' fits and updates)

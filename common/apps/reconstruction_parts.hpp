@@ -4,6 +4,8 @@
 //                             fitted points, one guarded step at a time, strays dropped;
 //   reconstruction_snap.cpp   every finer level (and a single one): the snap of the front onto
 //                             the local fits, pass after pass;
+//   reconstruction_fits.cpp   a snap pass's local fits of one brick's voxels, shared along
+//                             columns and blocks of voxels that see the same points;
 //   reconstruction_carve.cpp  gaps the start shell closed reopened where the points sampling
 //                             their walls lie buried inside the surface;
 //   reconstruction.cpp        validation, resolution and levels from the data, the levels in
@@ -44,6 +46,40 @@ double coarse_field_at(BandAccessor& acc, const NarrowBand& coarse, const std::v
 double field_at(BandAccessor& acc, const NarrowBand& band, const std::vector<float>& field, const Coord& c);
 // The next level's band: `coarse` at half the voxel size, half-width `half_width` voxels.
 NarrowBand upsample(const NarrowBand& coarse, double half_width, const ProgressHook& progress);
+
+// ---- reconstruction_fits.cpp
+// The local sheet fits of one brick's voxels for a snap pass (point_distance.hpp SheetModel),
+// shared where they see the same points. Thread-safe per NearbyPoints object.
+// A voxel that takes a fit: its slot, position, unit normal, the coarse curvature, its value
+// and its column within the brick (kColumns: the axis nearest its normal and the two other
+// coordinates).
+constexpr int kColumns = 3 * 64;
+struct FitVoxel {
+  std::size_t i;
+  Vec3d x, n;
+  double H, u;
+  int column;
+};
+
+struct FitSettings {
+  int neighbors, height_neighbors;
+  double min_band;      // world
+  double share_radius;  // world: columns share a fit whose quadric patch is at least this wide
+  double block_radius;  // world: 2x2 blocks of columns share one where it is at least this wide (0: never)
+  HeightNoise noise;    // the points' noise, which the height fits correct for (sheet_fit)
+};
+
+// The pass's fit settings at voxel size h (world): neighbors / height_neighbors points, the
+// sheet band min_band, the noise model; the sharing radii from the constants in the .cpp.
+FitSettings snap_fit_settings(int neighbors, int height_neighbors, double min_band, double h, HeightNoise noise);
+// The k nearest points of every voxel of brick b with |u| < window (world) from one radius
+// query (apps/nearby_points.hpp; identical results): around the box of those voxels; the
+// tree answers where the brick has fewer than a few such voxels.
+void prepare_brick_neighbours(const NarrowBand& band, std::uint32_t b, double window, int k, NearbyPoints& near);
+// The sheet fit of every voxel (fits[v] for voxels[v], one brick's), shared along columns and
+// across blocks of columns where the patches allow (see the .cpp); returns how many fits were made.
+int fit_voxels(const NearbyPoints& near, const std::vector<FitVoxel>& voxels, const FitSettings& fs,
+               std::vector<SheetFit>& fits);
 
 // ---- reconstruction_flow.cpp
 // The coarsest level's flow from the start shell `band` (voxel size h) toward the points'

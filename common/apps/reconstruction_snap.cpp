@@ -120,12 +120,6 @@ constexpr double kMaxNoiseShiftRedo = 0.5;
 // snap window take their neighbours' mean offset (the offset is nearly constant along the
 // normal; bench_reconstruct: the same Chamfer as fits on the whole window, 15% faster).
 constexpr double kFitWindow = 1.0;
-// Bricks with fewer fit voxels query the tree per voxel (a shared neighbourhood costs about
-// as much as a few tree queries).
-constexpr int kMinSharedFits = 4;
-// The voxels of a column along the normal share one fit where its quadric patch is at least
-// this many voxels wide (fit_voxels).
-constexpr double kShareRadius = 4.0;
 // A level's snap restarts when its first pass's noise reading asks for this many times the
 // height fits' points (snap_level).
 constexpr int kRestartGrowth = 4;
@@ -172,6 +166,7 @@ struct SnapPass {
   int smoothing = 0;            // extra smoothing passes of the offsets
   bool clean = false;           // the height fits' offsets were used, unaveraged
   std::uint64_t voxels = 0;     // snapped (fits computed)
+  std::uint64_t models = 0;     // sheet fits made for them (fit_voxels)
   std::uint64_t height_fits = 0;  // of them with a usable height fit
   std::uint64_t refused = 0;    // sign changes refused (not simple: they would change the topology)
 };
@@ -214,96 +209,6 @@ int noisy_height_neighbors(const NarrowBand& band, std::size_t points, double h_
   return int(std::clamp(std::lround(k), long(kNoisyHeightNeighbors) / 2, 256L));
 }
 
-// The k nearest points of every voxel of brick b with |u| < window from one radius query
-// (apps/nearby_points.hpp; identical results): around the box of those voxels (bunny, 20k
-// points, 0.1 %: the final level's fits, k = 46, 1.67 -> 1.37 s).
-void prepare_brick_neighbours(const NarrowBand& band, std::uint32_t b, double window, int k, NearbyPoints& near) {
-  Coord lo{kBrickDim, kBrickDim, kBrickDim}, hi{-1, -1, -1};
-  const Coord origin = brick_origin(band.bricks()[b].coord);
-  int count = 0;
-  band.for_each_active_in_brick(b, [&](const Coord& c, float value) {
-    if (!(std::abs(double(value)) < window)) return;
-    const Coord l = c - origin;
-    lo = {std::min(lo.x, l.x), std::min(lo.y, l.y), std::min(lo.z, l.z)};
-    hi = {std::max(hi.x, l.x), std::max(hi.y, l.y), std::max(hi.z, l.z)};
-    ++count;
-  });
-  if (count < kMinSharedFits) {
-    near.prepare({}, -1.0, k);  // the tree answers
-    return;
-  }
-  const Vec3d a = band.world(origin + lo), z = band.world(origin + hi);
-  near.prepare((a + z) * 0.5, 0.5 * length(z - a), k);
-}
-
-// A voxel that takes a fit: its slot, position, unit normal, the coarse curvature, its value
-// and its column within the brick (kColumns: the axis nearest its normal and the two other
-// coordinates).
-constexpr int kColumns = 3 * 64;
-struct FitVoxel {
-  std::size_t i;
-  Vec3d x, n;
-  double H, u;
-  int column;
-};
-
-struct FitSettings {
-  int neighbors, height_neighbors;
-  double min_band;      // world
-  double share_radius;  // world: columns share a fit whose quadric patch is at least this wide
-  HeightNoise noise;    // the points' noise, which the height fits correct for (sheet_fit)
-};
-
-// The sheet fit of every voxel (fits[v] for voxels[v]). The voxels of one column along the
-// normal (those within a voxel of the front: one to three) see the same points, so they share
-// one fit, made at their centroid along their mean normal and evaluated at each
-// (SheetModel::at), where its quadric patch is at least share_radius wide: the fits cost about
-// half. Neighbours across the normal keep fits of their own: the snap's averaging of the
-// offsets over neighbouring voxels needs independent fits (sharing 2x2x2 blocks cost 1-3 % of
-// Chamfer on bench_reconstruct --sweep at 20k points). A lone voxel, a column whose normals
-// disagree, and every voxel of a brick whose first shared patch was narrower take their own.
-void fit_voxels(const NearbyPoints& near, const std::vector<FitVoxel>& voxels, const FitSettings& fs,
-                std::vector<SheetFit>& fits) {
-  fits.resize(voxels.size());
-  std::array<int, kColumns + 1> first{};  // counting sort by column
-  for (const FitVoxel& v : voxels) ++first[std::size_t(v.column + 1)];
-  for (int k = 0; k < kColumns; ++k) first[std::size_t(k + 1)] += first[std::size_t(k)];
-  std::array<int, kColumns> fill{};
-  std::copy(first.begin(), first.begin() + kColumns, fill.begin());
-  std::array<int, kBrickVoxels> by_column;  // voxel indices grouped by column (a brick has at most 512)
-  for (std::size_t v = 0; v < voxels.size(); ++v) by_column[std::size_t(fill[std::size_t(voxels[v].column)]++)] = int(v);
-  auto own = [&](int v) {
-    fits[std::size_t(v)] = sheet_fit(near, voxels[std::size_t(v)].x, voxels[std::size_t(v)].n, fs.neighbors,
-                                     fs.height_neighbors, fs.min_band, fs.noise);
-  };
-  bool share = true;
-  for (int k = 0; k < kColumns; ++k) {
-    const int begin = first[std::size_t(k)], end = first[std::size_t(k + 1)], count = end - begin;
-    if (count == 0) continue;
-    Vec3d centroid{}, normal{};
-    for (int j = begin; j < end; ++j) {
-      centroid += voxels[std::size_t(by_column[std::size_t(j)])].x;
-      normal += voxels[std::size_t(by_column[std::size_t(j)])].n;
-    }
-    const double nl = length(normal);
-    if (!share || count == 1 || !(nl > 0.9 * count)) {
-      for (int j = begin; j < end; ++j) own(by_column[std::size_t(j)]);
-      continue;
-    }
-    const SheetModel model = sheet_model(near, centroid / double(count), normal / nl, fs.neighbors,
-                                         fs.height_neighbors, fs.min_band, fs.noise);
-    if (model.has_height && model.patch_radius() < fs.share_radius) {
-      share = false;
-      for (int j = begin; j < end; ++j) own(by_column[std::size_t(j)]);
-      continue;
-    }
-    for (int j = begin; j < end; ++j) {
-      const FitVoxel& v = voxels[std::size_t(by_column[std::size_t(j)])];
-      fits[std::size_t(by_column[std::size_t(j)])] = model.at(v.x);
-    }
-  }
-}
-
 struct SnapSettings {
   int neighbors = 8;             // plane fits
   int height_neighbors = kHeightNeighbors;  // height fits
@@ -328,8 +233,8 @@ SnapPass snap_to_fits(NarrowBand& band, const PointIndex& index, const SnapSetti
   const int neighbors = settings.neighbors;
   const bool same_grid = coarse.voxel_size() == h;  // a single level: its own curvature
   const float unset = std::numeric_limits<float>::quiet_NaN();
-  const FitSettings fit_settings{neighbors, settings.height_neighbors, kOneSidedBand * h, kShareRadius * h,
-                                 {settings.noise, settings.noisy_height, settings.soft_scales}};
+  const FitSettings fit_settings = snap_fit_settings(neighbors, settings.height_neighbors, kOneSidedBand * h, h,
+                                                     {settings.noise, settings.noisy_height, settings.soft_scales});
   // 1. The front offset e = clamp(s - u, +-h) of every voxel within the window.
   std::vector<float> offset(band.active_voxel_count(), unset);
   std::vector<std::uint8_t> moves(band.active_voxel_count(), 0);  // within the window
@@ -337,6 +242,7 @@ SnapPass snap_to_fits(NarrowBand& band, const PointIndex& index, const SnapSetti
   std::vector<double> spread(band.brick_count(), 0.0);  // per brick: sum of the fits' spread
   std::vector<std::uint32_t> fitted(band.brick_count(), 0);
   std::vector<std::uint32_t> heights(band.brick_count(), 0);
+  std::vector<std::uint32_t> models(band.brick_count(), 0);
   std::vector<double> residual(band.brick_count(), 0.0);  // per brick: sum of the height fits' residuals
   // Noisy data: each height fit's offset from the front before the clamp, and its noise gain
   // (SheetFit::noise_gain), to redo the noise correction with this pass's own noise below.
@@ -385,7 +291,7 @@ SnapPass snap_to_fits(NarrowBand& band, const PointIndex& index, const SnapSetti
                           const int across = axis == 0 ? l.y | l.z << 3 : axis == 1 ? l.x | l.z << 3 : l.x | l.y << 3;
                           voxels.push_back({i, band.world(c), g / gl, H, u, axis << 6 | across});
                         });
-                        fit_voxels(near, voxels, fit_settings, fits);
+                        models[b] = std::uint32_t(fit_voxels(near, voxels, fit_settings, fits));
                         for (std::size_t v = 0; v < voxels.size(); ++v) {
                           const FitVoxel& fv = voxels[v];
                           const SheetFit& sf = fits[v];
@@ -506,6 +412,7 @@ SnapPass snap_to_fits(NarrowBand& band, const PointIndex& index, const SnapSetti
   pass.smoothing = smoothing;
   pass.clean = clean;
   pass.height_fits = height_n;
+  for (const std::uint32_t m : models) pass.models += m;
   for (std::size_t b = 0; b < change.size(); ++b) {
     pass.mean_change += change[b];
     pass.voxels += count[b];
@@ -590,6 +497,7 @@ SnapOutput snap_level(NarrowBand band, const PointIndex& index, const Reconstruc
     const SnapPass snapped = snap_to_fits(band, index, settings, coarse, coarse_curvature, o.progress);
     stage.refused_flips += snapped.refused;
     stage.fit_voxels += snapped.voxels;
+    stage.fit_models += snapped.models;
     stage.seconds_fit += seconds_since(t_fit);
     const auto t_redistance = Clock::now();
     band = redistanced(band, W, 1.0, o.progress);
@@ -636,6 +544,7 @@ SnapOutput snap_level(NarrowBand band, const PointIndex& index, const Reconstruc
     stage.refused_flips += snapped.refused;
     stage.seconds_fit += seconds_since(t_fit);
     stage.fit_voxels += snapped.voxels;
+    stage.fit_models += snapped.models;
     stage.last_change = snapped.mean_change;
     stage.noise = snapped.noise;
     stage.height_noise = snapped.height_noise;

@@ -11,6 +11,7 @@
 #include <random>
 #include <utility>
 
+#include "apps/nearby_points.hpp"
 #include "apps/point_distance.hpp"
 
 namespace levelset::apps {
@@ -94,6 +95,56 @@ TEST(SheetFitScales, SoftChoiceKeepsDetailTheLargePatchCannotDescribe) {
     EXPECT_LT(soft, 1.2 * law) << lambda << ": law " << law << ", soft " << soft;
     EXPECT_LT(soft, 0.7 * two_scale_large) << lambda << ": soft " << soft << ", two-scale " << two_scale_large;
   }
+}
+
+
+// The share of soft-choice models (SheetModel::large_weight) that keep at least half the weight
+// on the largest patch, over the grid of rms_offset; each model's plane part checked against
+// sheet_fit's, and sheet_plane's against both, bit for bit.
+double large_share(const PointIndex& index, const HeightField& s, int k_height) {
+  NearbyPoints near(index);
+  int kept = 0, n = 0;
+  for (double x = 0.2; x <= 0.8; x += 0.0173)
+    for (double y = 0.2; y <= 0.8; y += 0.0191) {
+      const Vec3d at{x, y, s.f(x, y)};
+      near.prepare(at, 0.01, k_height);
+      const HeightNoise noise{0.0, false, true};
+      const SheetModel model = sheet_model(near, at, s.normal(x, y), 8, k_height, 0.05, noise);
+      const SheetFit fit = sheet_fit(index, at, s.normal(x, y), 8, k_height, 0.05, noise);
+      const LocalFit plane = sheet_plane(near, at, s.normal(x, y), 8, 0.05);
+      EXPECT_EQ(model.at(at).height_offset, fit.height_offset);
+      EXPECT_EQ(plane.ax, fit.plane.ax);
+      EXPECT_EQ(plane.sxy, fit.plane.sxy);
+      EXPECT_EQ(plane.spread, fit.plane.spread);
+      EXPECT_GE(model.large_weight, 0.0);
+      EXPECT_LE(model.large_weight, 1.0);
+      kept += model.large_weight >= 0.5 ? 1 : 0;
+      ++n;
+    }
+  return double(kept) / n;
+}
+
+TEST(SheetFitScales, LargeWeightTellsASmoothPatchFromDetail) {
+  // reconstruction_snap.cpp shares one height fit over 2x2 blocks of voxels only where the soft
+  // choice keeps at least half the weight on the largest patch: on most of the paraboloid (the
+  // rest is the blend reading noise as bias: 0.80 measured), almost nowhere on bumps the large
+  // patch cannot follow (0.01).
+  const HeightField bowl{[](double x, double y) { return 0.5 * ((x - 0.5) * (x - 0.5) + (y - 0.5) * (y - 0.5)); },
+                         [](double x, double y) {
+                           const Vec3d g{-(x - 0.5), -(y - 0.5), 1.0};
+                           return g / length(g);
+                         }};
+  const double a = 10.0 * kSigma, w = 2.0 * kPi / 0.06;
+  const HeightField bumps{[=](double x, double y) { return a * std::sin(w * x) * std::sin(w * y); },
+                          [=](double x, double y) {
+                            const Vec3d g{-a * w * std::cos(w * x) * std::sin(w * y),
+                                          -a * w * std::sin(w * x) * std::cos(w * y), 1.0};
+                            return g / length(g);
+                          }};
+  const double smooth = large_share(PointIndex(sample(bowl, kPoints, kSigma, 3)), bowl, 3 * kLawCount);
+  const double detail = large_share(PointIndex(sample(bumps, kPoints, kSigma, 5)), bumps, 3 * kLawCount);
+  EXPECT_GT(smooth, 0.7) << "detail " << detail;
+  EXPECT_LT(detail, 0.1) << "smooth " << smooth;
 }
 
 }  // namespace
