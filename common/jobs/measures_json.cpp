@@ -45,7 +45,7 @@ nlohmann::json stages_json(const std::vector<apps::ReconstructionStage>& stages)
                       {"buried_points", s.buried_points}, {"carved_regions", s.carved_regions}, {"pierced_regions", s.pierced_regions}, {"webs_cut", s.webs_cut},
                       {"carved_voxels", s.carved_voxels},
                       {"active_voxels", s.active_voxels},
-                      {"fit_voxels", s.fit_voxels}, {"seconds", s.seconds},
+                      {"fit_voxels", s.fit_voxels}, {"fit_models", s.fit_models}, {"seconds", s.seconds},
                       {"seconds_start", s.seconds_start}, {"seconds_fit", s.seconds_fit},
                       {"seconds_flow", s.seconds_flow}, {"seconds_redistance", s.seconds_redistance}});
   return levels;
