@@ -66,12 +66,15 @@ struct FitSettings {
   double min_band;      // world
   double share_radius;  // world: columns share a fit whose quadric patch is at least this wide
   double block_radius;  // world: 2x2 blocks of columns share one where it is at least this wide (0: never)
+  bool wide_blocks;     // the blocks are 4x4 columns (strong noise), each split into 2x2 where needed
   HeightNoise noise;    // the points' noise, which the height fits correct for (sheet_fit)
 };
 
 // The pass's fit settings at voxel size h (world): neighbors / height_neighbors points, the
-// sheet band min_band, the noise model; the sharing radii from the constants in the .cpp.
-FitSettings snap_fit_settings(int neighbors, int height_neighbors, double min_band, double h, HeightNoise noise);
+// sheet band min_band, the noise model, 4x4 blocks or 2x2; the sharing radii from the
+// constants in the .cpp.
+FitSettings snap_fit_settings(int neighbors, int height_neighbors, double min_band, double h, HeightNoise noise,
+                              bool wide_blocks);
 // The k nearest points of every voxel of brick b with |u| < window (world) from one radius
 // query (apps/nearby_points.hpp; identical results): around the box of those voxels; the
 // tree answers where the brick has fewer than a few such voxels.

@@ -214,6 +214,7 @@ struct SnapSettings {
   double height_guard = kHeightGuard;  // voxels: height fits within this of the plane fit's are used
   bool noisy_height = false;     // noisy data: the height fits' offsets as well (see kNoisyHeightNeighbors)
   bool soft_scales = false;      // the height fits' soft three-scale patch choice (kSoftScaleGrowth)
+  bool wide_blocks = false;      // noise above kReferenceNoise: fits shared over 4x4 blocks (reconstruction_fits.cpp)
   double noise = 0.0;            // world: the points' noise the previous pass measured, beyond kResidualFloor
   double window = kSnapWindow;   // voxels that move
   double fit_window = kFitWindow;  // voxels with their own fit (within the window)
@@ -233,7 +234,8 @@ SnapPass snap_to_fits(NarrowBand& band, const PointIndex& index, const SnapSetti
   const bool same_grid = coarse.voxel_size() == h;  // a single level: its own curvature
   const float unset = std::numeric_limits<float>::quiet_NaN();
   const FitSettings fit_settings = snap_fit_settings(neighbors, settings.height_neighbors, kOneSidedBand * h, h,
-                                                     {settings.noise, settings.noisy_height, settings.soft_scales});
+                                                     {settings.noise, settings.noisy_height, settings.soft_scales},
+                                                     settings.wide_blocks);
   // 1. The front offset e = clamp(s - u, +-h) of every voxel within the window.
   std::vector<float> offset(band.active_voxel_count(), unset);
   std::vector<std::uint8_t> moves(band.active_voxel_count(), 0);  // within the window
@@ -432,6 +434,7 @@ SnapSettings snap_settings(const ReconstructionOptions& o, const NarrowBand& ban
   // times the count law's points and choose the patch by the soft three-scale rule
   // (sheet_fit's HeightNoise::soft).
   settings.soft_scales = previous_height_noise >= kSoftScaleMinNoise && previous_height_noise <= kReferenceNoise;
+  settings.wide_blocks = previous_height_noise > kReferenceNoise;
   const int growth = settings.soft_scales ? kSoftScaleGrowth : 1;
   settings.height_neighbors = std::max(o.neighbors, kHeightNeighbors);
   if (previous_noise >= kCleanNoise) {

@@ -297,12 +297,13 @@ TEST(Reconstruction, StrongNoiseSphereAveragesOverTheHeightPatch) {
   const double n = double(r.mesh.vertices.size());
   EXPECT_LT(std::sqrt(sum2 / n), 0.325 * sigma);
   EXPECT_LT(std::abs(sum / n), 0.05 * sigma);  // no shrinkage
-  // The final level's patches are 12+ voxels wide: 2x2 blocks of columns share their height
-  // fits (reconstruction_fits.cpp): 0.13 fits per fit voxel measured, 0.34 with a fit per
-  // column (one to three voxels each).
+  // The final level's patches are 12+ voxels wide and the noise is strong: 4x4 blocks of
+  // columns share their height fits (reconstruction_fits.cpp): 0.066 fits per fit voxel
+  // measured (RMS 0.239 sigma), 0.13 with 2x2 blocks (0.243 sigma), 0.34 with a fit per column
+  // (one to three voxels each).
   const ReconstructionStage& last = r.stages.back();
   EXPECT_GT(last.fit_models, 0u);
-  EXPECT_LT(double(last.fit_models), 0.25 * double(last.fit_voxels)) << last.fit_models << " of " << last.fit_voxels;
+  EXPECT_LT(double(last.fit_models), 0.1 * double(last.fit_voxels)) << last.fit_models << " of " << last.fit_voxels;
 }
 
 // A thin tube under strong isotropic noise: a torus (radii 1 and 0.08) from 20k points with
