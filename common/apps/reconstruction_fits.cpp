@@ -172,9 +172,10 @@ void prepare_brick_neighbours(const NarrowBand& band, std::uint32_t b, double wi
 // the same points, so they share one fit, made at their centroid along their mean normal and
 // evaluated at each (SheetModel::at), where its quadric patch is at least share_radius wide:
 // the fits cost about half. Where the brick's first shared patch is at least block_radius wide
-// (many points per fit: noisy data), a 2x2 block of columns shares one, unless its scale
-// choice found detail (SheetModel::large_weight below kBlockLargeWeight: then its columns
-// share theirs). Narrower patches keep a fit per column: the snap's averaging of the offsets
+// (many points per fit: noisy data), a 2x2 block of columns shares one (4x4 under strong
+// noise, FitSettings::wide_blocks, falling back to its 2x2 blocks), unless its scale choice
+// found detail (SheetModel::large_weight below kBlockLargeWeight: then its columns share
+// theirs). Narrower patches keep a fit per column: the snap's averaging of the offsets
 // over neighbouring voxels needs independent fits (sharing 2x2x2 blocks cost 1-3 % of Chamfer
 // on bench_reconstruct --sweep at 20k points with 16-point fits). A lone voxel, a column whose
 // normals disagree, and every voxel of a brick whose first shared patch was narrower than
