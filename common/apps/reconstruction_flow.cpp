@@ -14,7 +14,6 @@
 #include "apps/patch_coverage.hpp"
 #include "apps/reconstruction_parts.hpp"
 #include "distance/redistance.hpp"
-#include "distance/redistance_near.hpp"
 #include "evolve/evolution.hpp"
 #include "grid/for_each_active_parallel.hpp"
 #include "grid/sign_components.hpp"
@@ -179,7 +178,6 @@ LevelOutput flow_level(NarrowBand band, const PointIndex& index, const Reconstru
   // topology is the result's (a part thinner than a coarse voxel, the bunny's ears,
   // otherwise broke off or grew handles depending on the sample set).
   const auto t_flow = Clock::now();
-  bool any_refused = false;
   if (!o.guard_flow) {
     // Unguarded: one evolve call, stopped by the mean |beta| near the front.
     ev.steps = o.max_steps;
@@ -219,25 +217,17 @@ LevelOutput flow_level(NarrowBand band, const PointIndex& index, const Reconstru
     TopologyGuardResult kept =
         guard_topology(band, r.band, std::vector<float>(r.band.values().begin(), r.band.values().end()), guard);
     const std::uint64_t refused = kept.refused_flips;
+    r.band.swap_values(kept.values);
     if (refused > 0) {
-      // Refused voxels hold the front at +-eps where the band upkeep had moved on: their
-      // neighbourhoods are redistanced (the rest of the band is the upkeep's distance).
+      // Refused voxels hold the front where the band upkeep had moved on: redistance on
+      // the domain grown by one voxel, as after a snap.
       stage.refused_flips += refused;
       const auto t_redistance = Clock::now();
-      std::vector<Coord> changed;
-      std::size_t i = 0;
-      for (std::uint32_t b = 0; b < r.band.brick_count(); ++b)
-        r.band.for_each_active_in_brick(b, [&](const Coord& c, float v) {
-          if (kept.values[i++] != v) changed.push_back(c);
-        });
-      r.band.swap_values(kept.values);
-      RedistanceNearOptions local;
-      local.progress = o.progress;
-      r.band = redistance_near(std::move(r.band), changed, local).band;
+      RedistanceOptions redo;
+      redo.half_width = W;
+      redo.progress = o.progress;
+      r.band = redistance(reframed(r.band, {}, W - 1.0), redo).band;
       stage.seconds_redistance += seconds_since(t_redistance);
-      any_refused = true;
-    } else {
-      r.band.swap_values(kept.values);
     }
     // Convergence: the mean motion of the voxels within one voxel of the front, measured
     // on the values after the topology control (the speed's own |beta| stays high where a
@@ -261,16 +251,6 @@ LevelOutput flow_level(NarrowBand band, const PointIndex& index, const Reconstru
     stage.last_change = near > 0 ? moved / double(near) / h : 0.0;
     o.progress.step(0.5 * double(step) / o.max_steps / levels, "reconstruct");
     if (stage.last_change < o.tolerance) break;
-  }
-  if (any_refused) {
-    // The local redistances kept the band's voxels: the domain grown by one voxel around the
-    // held fronts, as after a snap (the next level upsamples this band).
-    const auto t_redistance = Clock::now();
-    RedistanceOptions redo;
-    redo.half_width = W;
-    redo.progress = o.progress;
-    band = redistance(reframed(band, {}, W - 1.0), redo).band;
-    stage.seconds_redistance += seconds_since(t_redistance);
   }
   stage.seconds_flow = seconds_since(t_flow);
   stage.dropped_components = drop_unsupported_components(band, index, kSupportDistance * h, o.progress);
