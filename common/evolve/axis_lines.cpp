@@ -3,6 +3,11 @@
 #include <algorithm>
 #include <bit>
 
+#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__)
+#include <immintrin.h>
+#define LEVELSET_ROW_PACK_AVX2 1
+#endif
+
 namespace levelset::evolve::detail {
 
 namespace {
@@ -16,12 +21,12 @@ constexpr std::uint32_t bit_range(int lo, int hi) {
   return hi < lo ? 0u : ((hi >= 31 ? ~0u : (2u << hi) - 1u) & ~((1u << lo) - 1u));
 }
 
-// Fills the samples `fill` of a gap (in v) from the polynomial through its last active sample `last`
+// Fills the samples `fill` of a gap (in v, sample g at v[g * vstep]) from the polynomial through its last active sample `last`
 // and up to two more behind it, away from the gap (dir = +1: the gap lies above `last`):
 // through (0, p1), (-1, p2), (-2, p3) evaluated t = |g - last| steps into the gap; linear
 // through two samples, constant through one. Without branches on the sample count.
-void fill_from(float* v, const float* src, std::ptrdiff_t stride, std::uint32_t active, int last, int dir,
-               std::uint32_t fill) {
+void fill_from(float* v, std::ptrdiff_t vstep, const float* src, std::ptrdiff_t stride, std::uint32_t active,
+               int last, int dir, std::uint32_t fill) {
   auto on = [&](int q) { return q >= 0 && q < kLen && ((active >> q) & 1u); };
   auto at = [&](int q) { return double(src[q * stride]); };
   const int run = on(last - dir) ? (on(last - 2 * dir) ? 3 : 2) : 1;
@@ -31,7 +36,7 @@ void fill_from(float* v, const float* src, std::ptrdiff_t stride, std::uint32_t 
   for (; fill; fill &= fill - 1) {
     const int g = std::countr_zero(fill);
     const double t = double((g - last) * dir);
-    v[g] = float(p1 + t * a + 0.5 * t * t * b);
+    v[g * vstep] = float(p1 + t * a + 0.5 * t * t * b);
   }
 }
 
@@ -41,8 +46,8 @@ void fill_from(float* v, const float* src, std::ptrdiff_t stride, std::uint32_t 
 // The active samples are read from the tile (src, with its stride along the line), not from
 // the line just copied from it: a load right after a wide vector store of the copy would wait
 // for store forwarding.
-void extrapolate_line(float* v, const float* src, std::ptrdiff_t stride, std::uint32_t active, std::uint32_t need,
-                      int reach) {
+void extrapolate_line(float* v, std::ptrdiff_t vstep, const float* src, std::ptrdiff_t stride, std::uint32_t active,
+                      std::uint32_t need, int reach) {
   while (need) {
     const int g0 = std::countr_zero(need);
     // The gap [k, e) around g0.
@@ -52,8 +57,9 @@ void extrapolate_line(float* v, const float* src, std::ptrdiff_t stride, std::ui
     // Samples g with dl = g - k + 1 <= dr = e - g take the left side (all of them without a
     // right side), each side within `reach`.
     const int split = right ? (e + k - 1) / 2 : e - 1;
-    if (left) fill_from(v, src, stride, active, k - 1, 1, need & bit_range(k, std::min(split, k + reach - 1)));
-    if (right) fill_from(v, src, stride, active, e, -1, need & bit_range(std::max(left ? split + 1 : k, e - reach), e - 1));
+    if (left) fill_from(v, vstep, src, stride, active, k - 1, 1, need & bit_range(k, std::min(split, k + reach - 1)));
+    if (right)
+      fill_from(v, vstep, src, stride, active, e, -1, need & bit_range(std::max(left ? split + 1 : k, e - reach), e - 1));
     need &= ~bit_range(k, e - 1);
   }
 }
@@ -67,12 +73,13 @@ std::uint32_t needed_samples(std::uint32_t active, int reach) {
   return spread & ~active & kAll;
 }
 
-// Copies a line of the tile (src: its first sample, stride along it) and extrapolates it.
-void fill_line(float* l, const float* src, std::ptrdiff_t stride, std::uint32_t active, int reach) {
-  for (int k = 0; k < kLen; ++k) l[k] = src[k * stride];
+// Extrapolates the samples a line needs (v: its first sample in AxisLines, vstep apart; src:
+// the tile's, stride apart), which already holds the tile's copy.
+void extrapolate_needed(float* v, std::ptrdiff_t vstep, const float* src, std::ptrdiff_t stride, std::uint32_t active,
+                        int reach) {
   if (active == kAll) return;
   const std::uint32_t need = needed_samples(active, reach);
-  if (need) extrapolate_line(l, src, stride, active, need, reach);
+  if (need) extrapolate_line(v, vstep, src, stride, active, need, reach);
 }
 
 // Transposes the brick's 8 columns of kLen tile rows: bit k of out[i] is bit i - kLo of
@@ -95,6 +102,81 @@ std::array<std::uint32_t, kBrickDim> brick_columns(Rows row_at) {
   return out;
 }
 
+
+// N floats, inline (std::copy_n of a few floats became a call to memmove).
+template <int N>
+void copy_run(const float* from, float* to) {
+  for (int i = 0; i < N; ++i) to[i] = from[i];
+}
+
+// The first of brick row (y, z)'s samples along axis a at offset -kStencilReach from its
+// centres: sample j of the row's centre x is first[j * AxisLines::step(a) + x].
+const float* row_samples(const AxisLines& lines, int a, int y, int z) {
+  return a == 0   ? lines.at(0, 0, y, z, -kLo - kStencilReach)
+         : a == 1 ? lines.at(1, 0, y, z, y - kLo - kStencilReach)
+                  : lines.at(2, 0, y, z, z - kLo - kStencilReach);
+}
+
+// gather_centre_samples, one sample at a time.
+int gather_rows_portable(const AxisLines& lines, const BrickMask& active, int a, CentreSamples& s) {
+  const std::ptrdiff_t jstep = AxisLines::step(a);
+  int k = 0;
+  for (int z = 0; z < kBrickDim; ++z)
+    for (int y = 0; y < kBrickDim; ++y) {
+      const unsigned m = unsigned(active.words[std::size_t(z)] >> (8 * y)) & 0xffu;
+      if (m == 0) continue;
+      const float* first = row_samples(lines, a, y, z);
+      for (int j = 0; j < CentreSamples::kCount; ++j) {
+        const float* run = first + j * jstep;
+        float* out = s.at[std::size_t(j)].data() + k;
+        int t = 0;
+        for (int x = 0; x < kBrickDim; ++x) {  // branch-free packing
+          out[t] = run[x];
+          t += int((m >> x) & 1u);
+        }
+      }
+      k += std::popcount(m);
+    }
+  return k;
+}
+
+#ifdef LEVELSET_ROW_PACK_AVX2
+// kPack[m]: the positions of m's set bits, ascending, then zeros (a permutation that packs a
+// row's active lanes to its front).
+struct PackTable {
+  alignas(32) std::int32_t lanes[256][kBrickDim];
+};
+constexpr PackTable make_pack_table() {
+  PackTable t{};
+  for (unsigned m = 0; m < 256; ++m) {
+    int n = 0;
+    for (int x = 0; x < kBrickDim; ++x)
+      if ((m >> x) & 1u) t.lanes[m][n++] = x;
+  }
+  return t;
+}
+constexpr PackTable kPack = make_pack_table();
+
+// gather_rows_portable with one load, lane permutation and store per run.
+__attribute__((target("avx2"))) int gather_rows_avx2(const AxisLines& lines, const BrickMask& active, int a,
+                                                     CentreSamples& s) {
+  const std::ptrdiff_t jstep = AxisLines::step(a);
+  int k = 0;
+  for (int z = 0; z < kBrickDim; ++z)
+    for (int y = 0; y < kBrickDim; ++y) {
+      const unsigned m = unsigned(active.words[std::size_t(z)] >> (8 * y)) & 0xffu;
+      if (m == 0) continue;
+      const float* first = row_samples(lines, a, y, z);
+      const __m256i perm = _mm256_load_si256(reinterpret_cast<const __m256i*>(kPack.lanes[m]));
+      for (int j = 0; j < CentreSamples::kCount; ++j)
+        _mm256_storeu_ps(s.at[std::size_t(j)].data() + k,
+                         _mm256_permutevar8x32_ps(_mm256_loadu_ps(first + j * jstep), perm));
+      k += std::popcount(m);
+    }
+  return k;
+}
+#endif
+
 }  // namespace
 
 void fill_axis_lines(const float* tile, const std::uint32_t* rows, int reach, AxisLines& lines) {
@@ -104,19 +186,34 @@ void fill_axis_lines(const float* tile, const std::uint32_t* rows, int reach, Ax
     // Active bits along y of the lines (x, z) = (i, j), and along z of the lines (x, y) = (i, j).
     const std::array<std::uint32_t, kBrickDim> ys = brick_columns([&](int k) { return row(k, tj); });
     const std::array<std::uint32_t, kBrickDim> zs = brick_columns([&](int k) { return row(tj, k); });
+    // The y lines of the plane z = j and the z lines of the plane y = j: runs of 8 along x.
+    for (int p = 0; p < kLen; ++p) {
+      copy_run<kBrickDim>(tile + tile_index(0, p + kLo, j), lines.at(1, 0, 0, j, p));
+      copy_run<kBrickDim>(tile + tile_index(0, j, p + kLo), lines.at(2, 0, j, 0, p));
+    }
     for (int i = 0; i < kBrickDim; ++i) {
       // x lines: (y, z) = (i, j): one row.
       if (const std::uint32_t act = row(i - kLo, tj); act & kOwn) {
-        fill_line(lines.line(0, i, j), tile + tile_index(kLo, i, j), 1, act, reach);
+        const float* src = tile + tile_index(kLo, i, j);
+        copy_run<kLen>(src, lines.at(0, 0, i, j, 0));
+        extrapolate_needed(lines.at(0, 0, i, j, 0), 1, src, 1, act, reach);
       }
-      if (const std::uint32_t ay = ys[std::size_t(i)]; ay & kOwn) {
-        fill_line(lines.line(1, i, j), tile + tile_index(i, kLo, j), kDim, ay, reach);
-      }
-      if (const std::uint32_t az = zs[std::size_t(i)]; az & kOwn) {
-        fill_line(lines.line(2, i, j), tile + tile_index(i, j, kLo), kDim * kDim, az, reach);
-      }
+      if (const std::uint32_t ay = ys[std::size_t(i)]; ay & kOwn)
+        extrapolate_needed(lines.at(1, i, 0, j, 0), kBrickDim, tile + tile_index(i, kLo, j), kDim, ay, reach);
+      if (const std::uint32_t az = zs[std::size_t(i)]; az & kOwn)
+        extrapolate_needed(lines.at(2, i, j, 0, 0), kBrickDim, tile + tile_index(i, j, kLo), kDim * kDim, az, reach);
     }
   }
+}
+
+int gather_centre_samples(const AxisLines& lines, const BrickMask& active, int a, CentreSamples& s, bool allow_vector) {
+#ifdef LEVELSET_ROW_PACK_AVX2
+  static const bool avx2 = __builtin_cpu_supports("avx2");
+  if (avx2 && allow_vector) return gather_rows_avx2(lines, active, a, s);
+#else
+  (void)allow_vector;
+#endif
+  return gather_rows_portable(lines, active, a, s);
 }
 
 void upwind_sides(const AxisLines& lines, const BrickMask& active, Scheme scheme, const SidesWanted& want,
@@ -124,16 +221,7 @@ void upwind_sides(const AxisLines& lines, const BrickMask& active, Scheme scheme
   for (int a = 0; a < 3; ++a) {
     const bool minus = want.minus[std::size_t(a)], plus = want.plus[std::size_t(a)];
     if (!minus && !plus) continue;
-    int k = 0;
-    active.for_each_set([&](int n) {
-      const Coord l = local_coord(n);
-      // Line (i, j) across the axis and the position along it (AxisLines' layout).
-      const float* c = a == 0 ? lines.line(0, l.y, l.z) + (l.x - kLo)
-                       : a == 1 ? lines.line(1, l.x, l.z) + (l.y - kLo)
-                                : lines.line(2, l.x, l.y) + (l.z - kLo);
-      for (int j = 0; j < CentreSamples::kCount; ++j) sides.samples.at[std::size_t(j)][std::size_t(k)] = c[j - kStencilReach];
-      ++k;
-    });
+    const int k = gather_centre_samples(lines, active, a, sides.samples);
     one_sided_batch(sides.samples, k, scheme, minus ? sides.minus[std::size_t(a)].data() : nullptr,
                     plus ? sides.plus[std::size_t(a)].data() : nullptr);
   }

@@ -10,17 +10,23 @@
 //   active samples of the line (quadratic through the last three, linear through two), up to
 //   `reach` samples from them, so that upwind stencils near the edge see a smooth field. Only
 //   the samples a stencil of half-width `reach` around an active brick voxel reads are
-//   extrapolated (the others keep the tile's value). line(a, i, j)[k] is the sample at
-//   coordinate k + kLo along axis a (k in [0, kDim)), at (i, j) in [0, 8)^2 across (for a = 0:
-//   (y, z); 1: (x, z); 2: (x, y)). Only lines through at least one active brick voxel are
-//   filled.
+//   extrapolated (the others keep the tile's value). Layout (AxisLines::at): the samples of
+//   one brick row (y, z) of centres at one position along the axis lie side by side, x
+//   fastest, so a row's stencil samples are whole runs of 8 (x lines are rows of the tile; the
+//   y and z lines are stored as planes across them).
+// gather_centre_samples(lines, active, axis, samples, allow_vector)
+//   The 7 samples along `axis` around each of the brick's active voxels (ascending local
+//   index) into samples.at[j][k]; returns the count. Brick row by brick row: each row's 7 runs
+//   of 8 samples packed to its active voxels (one vector permutation per run where the CPU has
+//   AVX2 and allow_vector, else one sample at a time; the same samples either way).
 // upwind_sides(lines, active, scheme, want, sides)
 //   D-u and D+u (value units per voxel) along each axis at the brick's active voxels, for the
 //   axes and sides `want` asks for: the lines' samples around each voxel are gathered, then
 //   one_sided_batch evaluates them all (vector code, bit for bit one_side).
 //   sides.at(a, k) is the pair at the k-th active voxel; sides not wanted are left as they were.
-// Cost: O(3 * 64 * kDim) copies per brick plus the extrapolated gaps; upwind_sides 7 copies
-//   and about 60 flops per active voxel, axis and side (WENO5, vector). No allocation.
+// Cost: O(3 * 64 * kDim) copies per brick (runs of 8) plus the extrapolated gaps;
+//   upwind_sides 7 runs of 8 per brick row with an active voxel and axis, packed to the active
+//   voxels, and about 60 flops per active voxel, axis and side (WENO5, vector). No allocation.
 //   Threading: pure functions over caller-owned buffers (one per thread).
 // Internal to levelset_core (namespace evolve::detail).
 #pragma once
@@ -43,11 +49,19 @@ inline constexpr std::ptrdiff_t kTileStride[3] = {1, kDim, kDim * kDim};
 
 struct AxisLines {
   static constexpr int kLen = kDim;
+  // x: [z][y][p] (p = x - kLo); y: [z][p][x] (p = y - kLo); z: [y][p][x] (p = z - kLo).
   std::array<float, 3 * kBrickDim * kBrickDim * kLen> data{};
-  float* line(int a, int i, int j) { return data.data() + std::size_t(((a * kBrickDim + i) * kBrickDim + j) * kLen); }
-  const float* line(int a, int i, int j) const {
-    return data.data() + std::size_t(((a * kBrickDim + i) * kBrickDim + j) * kLen);
+  static constexpr std::size_t kAxisSize = std::size_t(kBrickDim) * kBrickDim * kLen;
+  // Sample at position p along axis a of the line through brick voxel (x, y, z) (the axis's
+  // own coordinate ignored), and the step between consecutive p.
+  static constexpr std::size_t index(int a, int x, int y, int z, int p) {
+    return a == 0   ? std::size_t((z * kBrickDim + y) * kLen + p)
+           : a == 1 ? kAxisSize + std::size_t((z * kLen + p) * kBrickDim + x)
+                    : 2 * kAxisSize + std::size_t((y * kLen + p) * kBrickDim + x);
   }
+  static constexpr std::ptrdiff_t step(int a) { return a == 0 ? 1 : kBrickDim; }
+  float* at(int a, int x, int y, int z, int p) { return data.data() + index(a, x, y, z, p); }
+  const float* at(int a, int x, int y, int z, int p) const { return data.data() + index(a, x, y, z, p); }
 };
 
 // Which one-sided derivatives to compute, per axis.
@@ -63,6 +77,8 @@ struct UpwindSides {
 };
 
 void fill_axis_lines(const float* tile, const std::uint32_t* rows, int reach, AxisLines& lines);
+int gather_centre_samples(const AxisLines& lines, const BrickMask& active, int axis, CentreSamples& samples,
+                          bool allow_vector = true);
 void upwind_sides(const AxisLines& lines, const BrickMask& active, Scheme scheme, const SidesWanted& want,
                   UpwindSides& sides);
 

@@ -25,7 +25,9 @@ namespace levelset::evolve {
 
 struct CentreSamples {
   static constexpr int kCount = 2 * kStencilReach + 1;
-  std::array<std::array<float, kBrickVoxels>, kCount> at;
+  // kBrickDim spare entries per sample: a caller may write whole brick rows of 8 and count
+  // only the active ones (axis_lines' row gather).
+  std::array<std::array<float, kBrickVoxels + kBrickDim>, kCount> at;
 };
 
 void one_sided_batch(const CentreSamples& samples, int count, Scheme scheme, double* minus, double* plus);
