@@ -4,69 +4,112 @@
 #include <array>
 #include <atomic>
 #include <cmath>
+#include <limits>
 
 #include <tbb/blocked_range.h>
+#include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
 
 #include "core/error.hpp"
+#include "core/uninitialized_vector.hpp"
 #include "distance/redistance_domain.hpp"
 
 namespace levelset::evolve {
 
 namespace {
 
-// A brick of the tracking domain and its six face neighbours (slot 0: the brick, 1 + f: the
-// neighbour across face f = 2 a + (1 if +a)), resolved once per brick: the voxels up to
-// three steps along an axis from the brick lie in these.
-struct BrickStar {
-  std::array<const float*, 7> value{};  // unsigned distances (voxels); null: no brick
-  std::array<const BrickMask*, 7> active{}, inside{}, edge{};
+// A brick of the tracking domain and the voxels up to three steps across each of its faces
+// (what a voxel of the brick reaches along an axis), as a dense tile: the previously active
+// voxels' signed distances (voxels; -0 for an inside voxel at distance 0), NaN elsewhere, so
+// one load answers "active?", "which side?" and "how far?". Samples off the cross (more than
+// one coordinate outside the brick) are never read and not filled.
+struct StarTile {
+  static constexpr int kReach = 3, kDim = kBrickDim + 2 * kReach;
+  static constexpr std::ptrdiff_t kStride[3] = {1, kDim, kDim * kDim};
+  std::array<float, std::size_t(kDim) * kDim * kDim> v;
 
-  struct At {
-    int slot = -1, index = 0;  // slot -1: outside the domain
-  };
-  // The voxel `steps` (1-3) from brick-local l across face direction f.
-  static At step(const Coord& l, int f, int steps, const BrickStar& star) {
-    const int a = f >> 1;
-    Coord q = l;
-    q[a] += (f & 1) ? steps : -steps;
-    int slot = 0;
-    if (q[a] < 0 || q[a] >= kBrickDim) {
-      slot = 1 + f;
-      q[a] -= (f & 1) ? kBrickDim : -kBrickDim;
-    }
-    if (!star.value[std::size_t(slot)]) return {};
-    return {slot, local_index(q.x, q.y, q.z)};
+  static constexpr std::size_t index(int x, int y, int z) {
+    return std::size_t((x + kReach) + kDim * ((y + kReach) + kDim * (z + kReach)));
   }
-  bool is_active(At p) const { return p.slot >= 0 && active[std::size_t(p.slot)]->test(p.index); }
-  bool is_inside(At p) const { return inside[std::size_t(p.slot)]->test(p.index); }
-  float distance(At p) const { return value[std::size_t(p.slot)][p.index]; }
-  // Signed value (voxels) of a previously active voxel.
-  float signed_at(At p) const { return is_inside(p) ? -distance(p) : distance(p); }
+  const float* at(const Coord& l) const { return v.data() + index(l.x, l.y, l.z); }
+  // From the signed values of the brick (slot 0) and its face neighbours (1 + f, face f =
+  // 2 a + (1 if +a); null: no brick).
+  void fill(const std::array<const float*, 7>& value) {
+    constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
+    // Rows of the brick (x in [0, 8)) and the y and z neighbours' slabs.
+    auto rows = [&](const float* src, int y0, int y1, int z0, int z1, int dy, int dz) {
+      for (int z = z0; z < z1; ++z)
+        for (int y = y0; y < y1; ++y) {
+          float* out = v.data() + index(0, y, z);
+          const float* in = src ? src + local_index(0, y - dy, z - dz) : nullptr;
+          for (int x = 0; x < kBrickDim; ++x) out[x] = in ? in[x] : kNaN;
+        }
+    };
+    rows(value[0], 0, kBrickDim, 0, kBrickDim, 0, 0);
+    rows(value[3], -kReach, 0, 0, kBrickDim, -kBrickDim, 0);  // -y
+    rows(value[4], kBrickDim, kBrickDim + kReach, 0, kBrickDim, kBrickDim, 0);  // +y
+    rows(value[5], 0, kBrickDim, -kReach, 0, 0, -kBrickDim);  // -z
+    rows(value[6], 0, kBrickDim, kBrickDim, kBrickDim + kReach, 0, kBrickDim);  // +z
+    // The x neighbours' three columns per row.
+    for (int z = 0; z < kBrickDim; ++z)
+      for (int y = 0; y < kBrickDim; ++y)
+        for (int k = 0; k < kReach; ++k) {
+          v[index(-1 - k, y, z)] = value[1] ? value[1][local_index(kBrickDim - 1 - k, y, z)] : kNaN;
+          v[index(kBrickDim + k, y, z)] = value[2] ? value[2][local_index(k, y, z)] : kNaN;
+        }
+  }
 };
 
-// Bit i of the result: the neighbour of voxel i across face f is set in the mask (star[0]: the
-// brick's, star[1 + f]: its face neighbours'; null: an empty mask). Layout (brick_mask.hpp):
-// word = z-slice, byte = y-row, bit = x.
-BrickMask neighbour_bits(const std::array<BrickMask, 7>& star, int f) {
-  constexpr std::uint64_t kCol0 = 0x0101010101010101ull, kCol7 = 0x8080808080808080ull;
-  const BrickMask& m = star[0];
-  const BrickMask& o = star[std::size_t(1 + f)];
-  BrickMask r;
-  for (int z = 0; z < 8; ++z) {
-    const std::uint64_t a = m.words[std::size_t(z)];
-    std::uint64_t v = 0;
-    switch (f) {
-      case 0: v = (a << 1 & ~kCol0) | (o.words[std::size_t(z)] & kCol7) >> 7; break;
-      case 1: v = (a >> 1 & ~kCol7) | (o.words[std::size_t(z)] & kCol0) << 7; break;
-      case 2: v = a << 8 | o.words[std::size_t(z)] >> 56; break;
-      case 3: v = a >> 8 | o.words[std::size_t(z)] << 56; break;
-      case 4: v = z > 0 ? m.words[std::size_t(z - 1)] : o.words[7]; break;
-      default: v = z < 7 ? m.words[std::size_t(z + 1)] : o.words[0]; break;
-    }
-    r.words[std::size_t(z)] = v;
+// Extrapolation to the voxel at tile sample c (signed values, StarTile) from previously active
+// voxels along the 6 axis directions: quadratic through the next three (linear through two),
+// on the direction where u changes fastest; skip bit f: the direction f may not be used (its
+// first voxel is an edge voxel). Signed values: the polynomial runs across the zero level,
+// where u is smooth. Returns the distance (voxels) when the result lies on the voxel's own
+// side (in_self: inside), else -1.
+float extrapolate(const float* c, bool in_self, unsigned skip) {
+  float best = 0.0f, step = -1.0f;
+  for (int f = 0; f < 6; ++f) {
+    const std::ptrdiff_t s = (f & 1) ? StarTile::kStride[f >> 1] : -StarTile::kStride[f >> 1];
+    const float u1 = c[s];
+    if (std::isnan(u1) || ((skip >> f) & 1u)) continue;
+    const float u2 = c[2 * s];
+    if (std::isnan(u2)) continue;
+    if (std::abs(u1 - u2) <= step) continue;
+    step = std::abs(u1 - u2);
+    best = 2.0f * u1 - u2;
+    if (const float u3 = c[3 * s]; !std::isnan(u3)) best = 3.0f * u1 - 3.0f * u2 + u3;
   }
-  return r;
+  if (step < 0.0f || (in_self ? best >= 0.0f : best <= 0.0f)) return -1.0f;
+  // A distance changes by at most one voxel per voxel: clamp to the range every active
+  // 6-neighbour on the same side allows (a polynomial through a kink could leave it, and a
+  // value pushed beyond W would leave a hole next to the front).
+  float lo = 0.0f, hi = detail::kInf;
+  for (int f = 0; f < 6; ++f) {
+    const float u = c[(f & 1) ? StarTile::kStride[f >> 1] : -StarTile::kStride[f >> 1]];
+    if (std::isnan(u) || std::signbit(u) != in_self) continue;
+    const float d = std::abs(u);
+    lo = std::max(lo, d - 1.0f);
+    hi = std::min(hi, d + 1.0f);
+  }
+  return std::clamp(std::abs(best), lo, std::max(lo, hi));
+}
+
+// Bit f: the face neighbour of brick-local voxel l across face f is set in its mask (star[0]:
+// the brick's, star[1 + f]: the neighbour across f; null: none).
+unsigned face_neighbour_bits(const std::array<const BrickMask*, 7>& star, const Coord& l) {
+  unsigned bits = 0;
+  for (int f = 0; f < 6; ++f) {
+    const int a = f >> 1;
+    Coord q = l;
+    q[a] += (f & 1) ? 1 : -1;
+    std::size_t slot = 0;
+    if (q[a] < 0 || q[a] >= kBrickDim) {
+      slot = std::size_t(1 + f);
+      q[a] -= (f & 1) ? kBrickDim : -kBrickDim;
+    }
+    if (star[slot] && star[slot]->test(local_index(q.x, q.y, q.z))) bits |= 1u << f;
+  }
+  return bits;
 }
 
 }  // namespace
@@ -79,17 +122,24 @@ TrackResult track_band(const NarrowBand& moved, const TrackOptions& options) {
   detail::RedistanceDomain w = detail::build_domain(moved, 1, options.progress);
   const std::size_t n = w.size();
 
-  // Previously active voxels: |u| / h, exactly as stored.
+  // Previously active voxels: |u| / h, exactly as stored, and signed (BrickStar::value).
   std::vector<BrickMask> old_active(n);
+  UninitializedVector<float> signed_values(n * kBrickVoxels);
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 32), [&](const tbb::blocked_range<std::size_t>& r) {
     for (std::size_t b = r.begin(); b != r.end(); ++b) {
+      float* sv = signed_values.data() + b * kBrickVoxels;
+      std::fill_n(sv, kBrickVoxels, std::numeric_limits<float>::quiet_NaN());
       const std::uint32_t src = w.source[b];
       if (src == kNoBrick) continue;
       const Brick& br = moved.bricks()[src];
       old_active[b] = br.active;
       float* d = w.values(std::uint32_t(b));
       const float* v = moved.values().data() + br.value_offset;
-      br.active.for_each_set([&](int i) { d[i] = float(std::abs(double(*v++)) / h); });
+      const BrickMask& inside = w.inside[b];
+      br.active.for_each_set([&](int i) {
+        d[i] = float(std::abs(double(*v++)) / h);
+        sv[i] = inside.test(i) ? -d[i] : d[i];
+      });
     }
   });
   // The band's edge layer (previously active voxels with an inactive 6-neighbour): their
@@ -124,70 +174,42 @@ TrackResult track_band(const NarrowBand& moved, const TrackOptions& options) {
       }
     }
   });
-  auto star_of = [&](std::size_t b) {
-    BrickStar st;
-    auto set = [&](std::size_t slot, std::uint32_t o) {
-      if (o == kNoBrick) return;
-      st.value[slot] = w.values(o);
-      st.active[slot] = &old_active[o];
-      st.inside[slot] = &w.inside[o];
-      st.edge[slot] = &edge[o];
-    };
-    set(0, std::uint32_t(b));
-    for (std::size_t f = 0; f < 6; ++f) set(1 + f, w.nbr[b][f]);
-    return st;
+  // The signed values and edge masks of brick b and its face neighbours (StarTile's slots).
+  auto star_values = [&](std::size_t b) {
+    std::array<const float*, 7> value{};
+    value[0] = signed_values.data() + b * kBrickVoxels;
+    for (std::size_t f = 0; f < 6; ++f)
+      if (const std::uint32_t o = w.nbr[b][f]; o != kNoBrick) value[1 + f] = signed_values.data() + std::size_t(o) * kBrickVoxels;
+    return value;
   };
-  // Extrapolation to voxel i of the star's brick from previously active voxels along the 6
-  // axis directions: quadratic through the next three (linear through two), on the direction
-  // where u changes fastest; the first one must not be an edge voxel when skip_edge. Signed
-  // values: the polynomial runs across the zero level, where u is smooth. Returns the
-  // distance (voxels) when the result lies on the voxel's own side, else -1.
-  auto extrapolate = [&](const BrickStar& st, int i, bool skip_edge) {
-    using At = BrickStar::At;
-    const Coord l = local_coord(i);
-    const bool in_self = st.inside[0]->test(i);
-    float best = 0.0f, step = -1.0f;
-    for (int f = 0; f < 6; ++f) {
-      const At p1 = BrickStar::step(l, f, 1, st);
-      if (!st.is_active(p1) || (skip_edge && st.edge[std::size_t(p1.slot)]->test(p1.index))) continue;
-      const At p2 = BrickStar::step(l, f, 2, st);
-      if (!st.is_active(p2)) continue;
-      const float u1 = st.signed_at(p1), u2 = st.signed_at(p2);
-      if (std::abs(u1 - u2) <= step) continue;
-      step = std::abs(u1 - u2);
-      best = 2.0f * u1 - u2;
-      const At p3 = BrickStar::step(l, f, 3, st);
-      if (st.is_active(p3)) best = 3.0f * u1 - 3.0f * u2 + st.signed_at(p3);
-    }
-    if (step < 0.0f || (in_self ? best >= 0.0f : best <= 0.0f)) return -1.0f;
-    // A distance changes by at most one voxel per voxel: clamp to the range every active
-    // 6-neighbour on the same side allows (a polynomial through a kink could leave it, and a
-    // value pushed beyond W would leave a hole next to the front).
-    float lo = 0.0f, hi = detail::kInf;
-    for (int f = 0; f < 6; ++f) {
-      const At p = BrickStar::step(l, f, 1, st);
-      if (!st.is_active(p) || st.is_inside(p) != in_self) continue;
-      const float d = st.distance(p);
-      lo = std::max(lo, d - 1.0f);
-      hi = std::min(hi, d + 1.0f);
-    }
-    return std::clamp(std::abs(best), lo, std::max(lo, hi));
+  auto star_edges = [&](std::size_t b) {
+    std::array<const BrickMask*, 7> masks{};
+    masks[0] = &edge[b];
+    for (std::size_t f = 0; f < 6; ++f)
+      if (const std::uint32_t o = w.nbr[b][f]; o != kNoBrick) masks[1 + f] = &edge[o];
+    return masks;
   };
+  tbb::enumerable_thread_specific<StarTile> tile;
   std::vector<std::vector<std::pair<int, float>>> edge_values(n);
   if (options.extrapolate_edge)
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 32), [&](const tbb::blocked_range<std::size_t>& r) {
     for (std::size_t b = r.begin(); b != r.end(); ++b) {
       if (edge[b].none()) continue;
-      const BrickStar st = star_of(b);
+      tile.local().fill(star_values(b));
+      const std::array<const BrickMask*, 7> edges = star_edges(b);
       edge[b].for_each_set([&](int i) {
-        const float d = extrapolate(st, i, true);
+        const Coord l = local_coord(i);
+        const float d = extrapolate(tile.local().at(l), w.inside[b].test(i), face_neighbour_bits(edges, l));
         if (d >= 0.0f) edge_values[b].push_back({i, d});
       });
     }
   });
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 32), [&](const tbb::blocked_range<std::size_t>& r) {
     for (std::size_t b = r.begin(); b != r.end(); ++b)
-      for (const auto& [i, d] : edge_values[b]) w.values(std::uint32_t(b))[i] = d;
+      for (const auto& [i, d] : edge_values[b]) {
+        w.values(std::uint32_t(b))[i] = d;
+        signed_values[b * kBrickVoxels + std::size_t(i)] = w.inside[b].test(i) ? -d : d;
+      }
   });
 
   // Newly reached voxels: the first-order Godunov distance update from their previously
@@ -202,34 +224,23 @@ TrackResult track_band(const NarrowBand& moved, const TrackOptions& options) {
       BrickMask fresh;
       for (int z = 0; z < 8; ++z) fresh.words[std::size_t(z)] = w.domain[b].words[std::size_t(z)] & ~old_active[b].words[std::size_t(z)];
       if (fresh.none()) continue;
-      const BrickStar st = star_of(b);
-      // Per face: the fresh voxels whose neighbour across it is previously active and on the
-      // same side, by mask arithmetic.
-      std::array<BrickMask, 7> in_star{}, out_star{};
-      for (std::size_t k = 0; k < 7; ++k)
-        if (st.value[k])
-          for (std::size_t z = 0; z < 8; ++z) {
-            in_star[k].words[z] = st.active[k]->words[z] & st.inside[k]->words[z];
-            out_star[k].words[z] = st.active[k]->words[z] & ~st.inside[k]->words[z];
-          }
-      std::array<BrickMask, 6> same_side;
-      for (int f = 0; f < 6; ++f) {
-        const BrickMask in_n = neighbour_bits(in_star, f), out_n = neighbour_bits(out_star, f);
-        for (std::size_t z = 0; z < 8; ++z)
-          same_side[std::size_t(f)].words[z] = fresh.words[z] & ((st.inside[0]->words[z] & in_n.words[z]) |
-                                                                  (~st.inside[0]->words[z] & out_n.words[z]));
-      }
+      StarTile& t = tile.local();
+      t.fill(star_values(b));
+      const BrickMask& inside = w.inside[b];
       fresh.for_each_set([&](int i) {
-        const Coord l = local_coord(i);
+        const float* c = t.at(local_coord(i));
+        const bool in_self = inside.test(i);
+        // The nearest previously active face neighbour on the same side, per axis.
         float m[3] = {detail::kInf, detail::kInf, detail::kInf};
-        for (int f = 0; f < 6; ++f)
-          if (same_side[std::size_t(f)].test(i))
-            m[f >> 1] = std::min(m[f >> 1], st.distance(BrickStar::step(l, f, 1, st)));
+        for (int f = 0; f < 6; ++f) {
+          const float u = c[(f & 1) ? StarTile::kStride[f >> 1] : -StarTile::kStride[f >> 1]];
+          if (!std::isnan(u) && std::signbit(u) == in_self) m[f >> 1] = std::min(m[f >> 1], std::abs(u));
+        }
         // The high-order extrapolation where it agrees with that to half a voxel (smooth
         // field; stencils near the edge read it), the Godunov value where it does not.
         const float first_order = detail::godunov(m[0], m[1], m[2]);
         // Beyond W + 1/2 neither value activates the voxel: skip the extrapolation.
-        const float high = first_order <= float(w_half) + 0.5f ? extrapolate(st, i, false) : -1.0f;
+        const float high = first_order <= float(w_half) + 0.5f ? extrapolate(c, in_self, 0u) : -1.0f;
         const float best = high >= 0.0f && std::abs(high - first_order) <= 0.5f ? high : first_order;
         d[i] = best;
         count += best <= float(w_half);
