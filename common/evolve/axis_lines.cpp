@@ -117,26 +117,42 @@ const float* row_samples(const AxisLines& lines, int a, int y, int z) {
                   : lines.at(2, 0, y, z, z - kLo - kStencilReach);
 }
 
-// gather_centre_samples, one sample at a time.
-int gather_rows_portable(const AxisLines& lines, const BrickMask& active, int a, CentreSamples& s) {
-  const std::ptrdiff_t jstep = AxisLines::step(a);
-  int k = 0;
+// The brick's rows that hold an active voxel, in ascending local index: the row's mask (bit
+// x) and its y and z.
+struct ActiveRows {
+  int count = 0;
+  std::array<std::uint8_t, kBrickDim * kBrickDim> mask, y, z;
+};
+
+ActiveRows active_rows(const BrickMask& active) {
+  ActiveRows rows;
   for (int z = 0; z < kBrickDim; ++z)
-    for (int y = 0; y < kBrickDim; ++y) {
-      const unsigned m = unsigned(active.words[std::size_t(z)] >> (8 * y)) & 0xffu;
-      if (m == 0) continue;
-      const float* first = row_samples(lines, a, y, z);
-      for (int j = 0; j < CentreSamples::kCount; ++j) {
-        const float* run = first + j * jstep;
-        float* out = s.at[std::size_t(j)].data() + k;
-        int t = 0;
-        for (int x = 0; x < kBrickDim; ++x) {  // branch-free packing
-          out[t] = run[x];
-          t += int((m >> x) & 1u);
-        }
+    for (int y = 0; y < kBrickDim; ++y)
+      if (const unsigned m = unsigned(active.words[std::size_t(z)] >> (8 * y)) & 0xffu; m != 0) {
+        rows.mask[std::size_t(rows.count)] = std::uint8_t(m);
+        rows.y[std::size_t(rows.count)] = std::uint8_t(y);
+        rows.z[std::size_t(rows.count++)] = std::uint8_t(z);
       }
-      k += std::popcount(m);
+  return rows;
+}
+
+// gather_centre_samples, one sample at a time.
+int gather_rows_portable(const AxisLines& lines, const ActiveRows& rows, int a, CentreSamples& s) {
+  int k = 0;
+  for (int r = 0; r < rows.count; ++r) {
+    const unsigned m = rows.mask[std::size_t(r)];
+    const float* first = row_samples(lines, a, rows.y[std::size_t(r)], rows.z[std::size_t(r)]);
+    for (int j = 0; j < CentreSamples::kCount; ++j) {
+      const float* run = first + j * AxisLines::step(a);
+      float* out = s.at[std::size_t(j)].data() + k;
+      int t = 0;
+      for (int x = 0; x < kBrickDim; ++x) {  // branch-free packing
+        out[t] = run[x];
+        t += int((m >> x) & 1u);
+      }
     }
+    k += std::popcount(m);
+  }
   return k;
 }
 
@@ -158,24 +174,32 @@ constexpr PackTable make_pack_table() {
 constexpr PackTable kPack = make_pack_table();
 
 // gather_rows_portable with one load, lane permutation and store per run.
-__attribute__((target("avx2"))) int gather_rows_avx2(const AxisLines& lines, const BrickMask& active, int a,
+__attribute__((target("avx2"))) int gather_rows_avx2(const AxisLines& lines, const ActiveRows& rows, int a,
                                                      CentreSamples& s) {
-  const std::ptrdiff_t jstep = AxisLines::step(a);
   int k = 0;
-  for (int z = 0; z < kBrickDim; ++z)
-    for (int y = 0; y < kBrickDim; ++y) {
-      const unsigned m = unsigned(active.words[std::size_t(z)] >> (8 * y)) & 0xffu;
-      if (m == 0) continue;
-      const float* first = row_samples(lines, a, y, z);
-      const __m256i perm = _mm256_load_si256(reinterpret_cast<const __m256i*>(kPack.lanes[m]));
-      for (int j = 0; j < CentreSamples::kCount; ++j)
-        _mm256_storeu_ps(s.at[std::size_t(j)].data() + k,
-                         _mm256_permutevar8x32_ps(_mm256_loadu_ps(first + j * jstep), perm));
-      k += std::popcount(m);
-    }
+  for (int r = 0; r < rows.count; ++r) {
+    const unsigned m = rows.mask[std::size_t(r)];
+    const float* first = row_samples(lines, a, rows.y[std::size_t(r)], rows.z[std::size_t(r)]);
+    const __m256i perm = _mm256_load_si256(reinterpret_cast<const __m256i*>(kPack.lanes[m]));
+    for (int j = 0; j < CentreSamples::kCount; ++j)
+      _mm256_storeu_ps(s.at[std::size_t(j)].data() + k,
+                       _mm256_permutevar8x32_ps(_mm256_loadu_ps(first + j * AxisLines::step(a)), perm));
+    k += std::popcount(m);
+  }
   return k;
 }
 #endif
+
+// gather_centre_samples over the brick's active rows.
+int gather_rows(const AxisLines& lines, const ActiveRows& rows, int a, CentreSamples& s, bool allow_vector) {
+#ifdef LEVELSET_ROW_PACK_AVX2
+  static const bool avx2 = __builtin_cpu_supports("avx2");
+  if (avx2 && allow_vector) return gather_rows_avx2(lines, rows, a, s);
+#else
+  (void)allow_vector;
+#endif
+  return gather_rows_portable(lines, rows, a, s);
+}
 
 }  // namespace
 
@@ -207,21 +231,16 @@ void fill_axis_lines(const float* tile, const std::uint32_t* rows, int reach, Ax
 }
 
 int gather_centre_samples(const AxisLines& lines, const BrickMask& active, int a, CentreSamples& s, bool allow_vector) {
-#ifdef LEVELSET_ROW_PACK_AVX2
-  static const bool avx2 = __builtin_cpu_supports("avx2");
-  if (avx2 && allow_vector) return gather_rows_avx2(lines, active, a, s);
-#else
-  (void)allow_vector;
-#endif
-  return gather_rows_portable(lines, active, a, s);
+  return gather_rows(lines, active_rows(active), a, s, allow_vector);
 }
 
 void upwind_sides(const AxisLines& lines, const BrickMask& active, Scheme scheme, const SidesWanted& want,
                   UpwindSides& sides) {
+  const ActiveRows rows = active_rows(active);
   for (int a = 0; a < 3; ++a) {
     const bool minus = want.minus[std::size_t(a)], plus = want.plus[std::size_t(a)];
     if (!minus && !plus) continue;
-    const int k = gather_centre_samples(lines, active, a, sides.samples);
+    const int k = gather_rows(lines, rows, a, sides.samples, true);
     one_sided_batch(sides.samples, k, scheme, minus ? sides.minus[std::size_t(a)].data() : nullptr,
                     plus ? sides.plus[std::size_t(a)].data() : nullptr);
   }
