@@ -32,6 +32,8 @@ struct StarTile {
     return std::size_t((x + kReach) + kDim * ((y + kReach) + kDim * (z + kReach)));
   }
   const float* at(const Coord& l) const { return v.data() + index(l.x, l.y, l.z); }
+  // The step to the neighbour across face f = 2 a + (1 if +a).
+  static constexpr std::ptrdiff_t face_step(int f) { return (f & 1) ? kStride[f >> 1] : -kStride[f >> 1]; }
   // From the signed values of the brick (slot 0) and its face neighbours (1 + f, face f =
   // 2 a + (1 if +a); null: no brick).
   void fill(const std::array<const float*, 7>& value) {
@@ -69,7 +71,7 @@ struct StarTile {
 float extrapolate(const float* c, bool in_self, unsigned skip) {
   float best = 0.0f, step = -1.0f;
   for (int f = 0; f < 6; ++f) {
-    const std::ptrdiff_t s = (f & 1) ? StarTile::kStride[f >> 1] : -StarTile::kStride[f >> 1];
+    const std::ptrdiff_t s = StarTile::face_step(f);
     const float u1 = c[s];
     if (std::isnan(u1) || ((skip >> f) & 1u)) continue;
     const float u2 = c[2 * s];
@@ -85,7 +87,7 @@ float extrapolate(const float* c, bool in_self, unsigned skip) {
   // value pushed beyond W would leave a hole next to the front).
   float lo = 0.0f, hi = detail::kInf;
   for (int f = 0; f < 6; ++f) {
-    const float u = c[(f & 1) ? StarTile::kStride[f >> 1] : -StarTile::kStride[f >> 1]];
+    const float u = c[StarTile::face_step(f)];
     if (std::isnan(u) || std::signbit(u) != in_self) continue;
     const float d = std::abs(u);
     lo = std::max(lo, d - 1.0f);
@@ -122,7 +124,7 @@ TrackResult track_band(const NarrowBand& moved, const TrackOptions& options) {
   detail::RedistanceDomain w = detail::build_domain(moved, 1, options.progress);
   const std::size_t n = w.size();
 
-  // Previously active voxels: |u| / h, exactly as stored, and signed (BrickStar::value).
+  // Previously active voxels: |u| / h, exactly as stored, and signed (StarTile's values).
   std::vector<BrickMask> old_active(n);
   UninitializedVector<float> signed_values(n * kBrickVoxels);
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 32), [&](const tbb::blocked_range<std::size_t>& r) {
@@ -233,7 +235,7 @@ TrackResult track_band(const NarrowBand& moved, const TrackOptions& options) {
         // The nearest previously active face neighbour on the same side, per axis.
         float m[3] = {detail::kInf, detail::kInf, detail::kInf};
         for (int f = 0; f < 6; ++f) {
-          const float u = c[(f & 1) ? StarTile::kStride[f >> 1] : -StarTile::kStride[f >> 1]];
+          const float u = c[StarTile::face_step(f)];
           if (!std::isnan(u) && std::signbit(u) == in_self) m[f >> 1] = std::min(m[f >> 1], std::abs(u));
         }
         // The high-order extrapolation where it agrees with that to half a voxel (smooth
