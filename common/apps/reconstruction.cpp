@@ -89,14 +89,14 @@ std::string stage_line(const ReconstructionStage& stage) {
   char line[640];
   std::snprintf(line, sizeof line,
                 "level %d: h %.4g, shell offset %.2f voxel, %s %d, change %.4f voxel, noise %.3f voxel (height fits %.3f), "
-                "%s (%d points), smoothing %d, %llu buried points, %d regions carved (%d pierced, %d webs cut, %llu voxels), %llu voxels, "
+                "%s (%d points), smoothing %d, %llu buried points, %d regions carved (%d pierced, %d webs cut, %llu voxels), %d web tunnels, %llu voxels, "
                 "%llu fits (%llu height, %llu models); start %.3f s, "
                 "fits %.3f s, flow %.3f s, redistance %.3f s, total %.3f s",
                 stage.level, stage.voxel_size, stage.shell_offset, stage.level == 0 ? "flow steps" : "snap passes",
                 stage.steps, stage.last_change, stage.noise, stage.height_noise,
                 stage.second_order ? "second order" : "plane fits", stage.height_neighbors, stage.smoothing,
                 static_cast<unsigned long long>(stage.buried_points), stage.carved_regions, stage.pierced_regions, stage.webs_cut,
-                static_cast<unsigned long long>(stage.carved_voxels),
+                static_cast<unsigned long long>(stage.carved_voxels), stage.web_tunnels,
                 static_cast<unsigned long long>(stage.active_voxels), static_cast<unsigned long long>(stage.fit_voxels),
                 static_cast<unsigned long long>(stage.height_fits),
                 static_cast<unsigned long long>(stage.fit_models), stage.seconds_start, stage.seconds_fit,
@@ -255,6 +255,7 @@ ReconstructionResult reconstruct_surface(const std::vector<Vec3d>& input, const 
       where.carve.pierce = o.pierce_tunnels;
       where.carve.narrow = o.narrow_gaps;
       where.carve.cut_webs = o.cut_webs;
+      where.carve.web_tunnels = o.web_tunnels;
       where.carve.clearance_points = projected.get();
       where.carve.clearance_noise = projected_noise;
       detail::SnapOutput snapped = detail::snap_level(std::move(band), *index, o, where, std::move(stage), noise);

@@ -162,6 +162,7 @@ struct ReconstructionOptions {
   bool pierce_tunnels = true;   // carve_gaps: a gap lined almost only by buried points may reopen as a tunnel
   bool narrow_gaps = true;      // carve_gaps: a second carving reopens gaps narrower than the sampling gap's clearance
   bool cut_webs = true;         // carve_gaps: sheets of the inside exposed to the outside and clear of every point are cut where that removes a handle
+  bool web_tunnels = true;      // carve_gaps: such sheets spanning a handle's hole (wherever they lie) are cut where that opens one tunnel
   bool denoised_clearance = true;  // carve_gaps under noise (sigma > 0.5 final voxels): clearance from points projected onto their planes
   int max_resolution = 4096;    // cap on the final grid's longest side (voxels)
   ProgressHook progress;
@@ -188,6 +189,7 @@ struct ReconstructionStage {
   int carved_regions = 0;           // finer levels: closed gaps reopened (turned outside)
   int pierced_regions = 0;          // of them reopened whole, tunnels allowed (pierce_tunnels), or webs cut
   int webs_cut = 0;                 // of those, webs (cut_webs)
+  int web_tunnels = 0;              // finer levels: webs spanning a handle's hole cut, one tunnel each (web_tunnels)
   std::uint64_t carved_voxels = 0;
   std::uint64_t active_voxels = 0;
   std::uint64_t fit_voxels = 0; // local fits computed (cache, or snapped voxels of all passes)

@@ -232,7 +232,8 @@ std::vector<std::uint64_t> air_candidates(const NarrowBand& band, const PointInd
   return air;
 }
 
-// The 6-connected components of the voxels `air` (sorted keys): each one's root index.
+}  // namespace
+
 std::vector<std::uint32_t> label_regions(const std::vector<std::uint64_t>& air) {
   auto find = [&](const Coord& c) -> std::int64_t {
     const auto it = std::lower_bound(air.begin(), air.end(), key_of(c));
@@ -254,8 +255,6 @@ std::vector<std::uint32_t> label_regions(const std::vector<std::uint64_t>& air) 
   for (std::size_t i = 0; i < air.size(); ++i) root[i] = find_root(parent, std::uint32_t(i));
   return root;
 }
-
-}  // namespace
 
 std::int64_t euler_lost(BandAccessor& acc, const std::vector<std::uint64_t>& region) {
   std::vector<std::uint64_t> anchors;
@@ -290,12 +289,6 @@ std::int64_t euler_lost(BandAccessor& acc, const std::vector<std::uint64_t>& reg
 
 namespace {
 
-// Steps 2-4: which candidates are carved (sorted keys) and which of them pierced, with the
-// counts of regions.
-struct RegionChoice {
-  std::vector<std::uint64_t> carved, pierced;
-  int regions = 0, pierced_regions = 0, webs = 0;
-};
 // Steps 2-3: per region (indexed by its root in label_regions), its size, its faces on the
 // outside (mouth), its voxels with such a face (exposed), and its lining: the points within
 // clearance + 1.5 h of its boundary voxels, and of them those deeper than lining_depth.
@@ -346,11 +339,8 @@ RegionStats region_stats(const NarrowBand& band, const PointIndex& index, const 
   return st;
 }
 
-// The candidates' indices grouped by region (a region's keys stay sorted) and where each
-// region's group starts (indexed by its root).
-struct RegionGroups {
-  std::vector<std::uint32_t> order, start;
-};
+}  // namespace
+
 RegionGroups group_by_region(const std::vector<std::uint32_t>& root) {
   RegionGroups g;
   g.order.resize(root.size());
@@ -360,6 +350,8 @@ RegionGroups group_by_region(const std::vector<std::uint32_t>& root) {
   for (std::size_t j = g.order.size(); j-- > 0;) g.start[root[g.order[j]]] = std::uint32_t(j);
   return g;
 }
+
+namespace {
 
 RegionChoice carve_regions(const NarrowBand& band, const PointIndex& index, const std::vector<std::uint64_t>& air,
                            const std::vector<float>& value, double lining_depth, double clearance, bool allow_pierce,
@@ -467,13 +459,9 @@ void drop_web_scraps(NarrowBand& band, const std::vector<std::uint64_t>& cut) {
   band.swap_values(values);
 }
 
-// 5. The band with the chosen regions dug out (see below), how many voxels turned outside and
-// the bricks touched.
-struct Dug {
-  NarrowBand band;
-  std::uint64_t carved_voxels = 0;
-  std::vector<std::uint64_t> bricks;  // sorted brick keys
-};
+}  // namespace
+
+// 5. (See the header; the steps below.)
 Dug dig_regions(const NarrowBand& band, const RegionChoice& choice, const ProgressHook& progress) {
   Dug out;
   const double h = band.voxel_size();
@@ -529,6 +517,8 @@ Dug dig_regions(const NarrowBand& band, const RegionChoice& choice, const Progre
   return out;
 }
 
+namespace {
+
 // One carving (see reconstruction_parts.hpp) with the given settings; its candidates lie no
 // farther than `outer` from every point (the narrow carving leaves the space beyond the first
 // one's clearance, which that carving has judged, alone).
@@ -569,6 +559,16 @@ CarveOutput carve_buried_gaps(NarrowBand band, const PointIndex& index, const Ca
                               const ProgressHook& progress) {
   const double h = band.voxel_size();
   CarveOutput out = carve_once(std::move(band), index, s, std::numeric_limits<double>::infinity(), progress);
+  if (s.web_tunnels) {
+    WebTunnels webs = open_web_tunnels(std::move(out.band), s.clearance_points ? *s.clearance_points : index,
+                                       clearance_of(s, h), progress);
+    out.band = std::move(webs.band);
+    out.web_tunnels = webs.tunnels;
+    out.carved_voxels += webs.voxels;
+    out.bricks.insert(out.bricks.end(), webs.bricks.begin(), webs.bricks.end());
+    std::sort(out.bricks.begin(), out.bricks.end());
+    out.bricks.erase(std::unique(out.bricks.begin(), out.bricks.end()), out.bricks.end());
+  }
   if (!s.narrow) return out;
   // The narrow gaps (see kNarrowGapClearance), after the wide ones are open: simple flips only.
   CarveSettings narrow = s;

@@ -485,6 +485,7 @@ SnapOutput snap_level(NarrowBand band, const PointIndex& index, const Reconstruc
     stage.carved_regions = carved.regions;
     stage.pierced_regions = carved.pierced_regions;
     stage.webs_cut = carved.webs;
+    stage.web_tunnels = carved.web_tunnels;
     stage.carved_voxels = carved.carved_voxels;
     carved_bricks = std::move(carved.bricks);
   }
