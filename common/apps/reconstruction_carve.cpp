@@ -560,8 +560,11 @@ CarveOutput carve_buried_gaps(NarrowBand band, const PointIndex& index, const Ca
   const double h = band.voxel_size();
   CarveOutput out = carve_once(std::move(band), index, s, std::numeric_limits<double>::infinity(), progress);
   if (s.web_tunnels) {
-    WebTunnels webs = open_web_tunnels(std::move(out.band), s.clearance_points ? *s.clearance_points : index,
-                                       clearance_of(s, h), progress);
+    WebTunnelSettings ws;
+    ws.clearance = clearance_of(s, h);
+    ws.lining_depth = std::max(kCarveDepthVoxels * h, kLiningNoiseDepth * s.noise);
+    ws.clearance_points = s.clearance_points;
+    WebTunnels webs = open_web_tunnels(std::move(out.band), index, ws, progress);
     out.band = std::move(webs.band);
     out.web_tunnels = webs.tunnels;
     out.carved_voxels += webs.voxels;

@@ -4,6 +4,8 @@
 // than the data. This finds such sheets and turns them outside where that opens one tunnel.
 #include <algorithm>
 #include <cstdint>
+#include <optional>
+#include <unordered_set>
 #include <vector>
 
 #include <tbb/blocked_range.h>
@@ -11,6 +13,7 @@
 
 #include "apps/reconstruction_parts.hpp"
 #include "grid/band_accessor.hpp"
+#include "grid/interpolate.hpp"
 #include "surface/marching_cubes.hpp"
 #include "surface/mesh_measures.hpp"
 
@@ -20,23 +23,54 @@ namespace {
 
 const Coord kFaceSteps[6] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
 
-// Inside voxels of the band farther than `clearance` from every point (sorted keys).
+// The band's active inside voxels farther than `clearance` from every point that are
+// connected (6-neighbours, through such voxels) to one beside the outside (sorted keys): the
+// components of those voxels that could be a sheet (the others are exposed nowhere). The
+// voxels beside the outside are tested in parallel, the rest only as the flood reaches them.
 std::vector<std::uint64_t> unsupported_inside(const NarrowBand& band, const PointIndex& points, double clearance,
                                               const ProgressHook& progress) {
+  auto clear = [&](const Coord& c) { return points.nearest(band.world(c)).distance > clearance; };
   std::vector<std::vector<std::uint64_t>> per_brick(band.brick_count());
   tbb::parallel_for(tbb::blocked_range<std::uint32_t>(0, std::uint32_t(band.brick_count()), 16),
                     [&](const tbb::blocked_range<std::uint32_t>& r) {
                       progress.check("reconstruct webs");
+                      BandAccessor acc(band);
                       for (std::uint32_t b = r.begin(); b != r.end(); ++b)
                         band.for_each_active_in_brick(b, [&](const Coord& c, float v) {
-                          if (v < 0.0f && points.nearest(band.world(c)).distance > clearance)
-                            per_brick[b].push_back(key_of(c));
+                          if (v >= 0.0f) return;
+                          bool exposed = false;
+                          for (const Coord& step : kFaceSteps) exposed = exposed || !acc.is_inside(c + step);
+                          if (exposed && clear(c)) per_brick[b].push_back(key_of(c));
                         });
                     });
   std::vector<std::uint64_t> keys;
   for (const auto& k : per_brick) keys.insert(keys.end(), k.begin(), k.end());
+  std::unordered_set<std::uint64_t> seen(keys.begin(), keys.end());
+  BandAccessor acc(band);
+  for (std::size_t at = 0; at < keys.size(); ++at)
+    for (const Coord& step : kFaceSteps) {
+      const Coord q = coord_of(keys[at]) + step;
+      if (!seen.insert(key_of(q)).second) continue;
+      const std::optional<float> u = acc.probe(q);
+      if (u && *u < 0.0f && clear(q)) keys.push_back(key_of(q));
+    }
   std::sort(keys.begin(), keys.end());
   return keys;
+}
+
+// The share of a region's lining (the points within `reach` of its voxels) deeper than
+// `depth` inside the surface (the band's values).
+double buried_lining_share(BandAccessor& acc, const NarrowBand& band, const PointIndex& points,
+                           const std::vector<std::uint64_t>& region, double reach, double depth) {
+  std::unordered_set<std::uint32_t> lining;
+  std::vector<std::pair<std::uint32_t, double>> near;
+  for (const std::uint64_t k : region) {
+    points.within(band.world(coord_of(k)), reach, near);
+    for (const auto& [i, d2] : near) lining.insert(i);
+  }
+  std::size_t buried = 0;
+  for (const std::uint32_t i : lining) buried += double(sample_trilinear(acc, band, points.points()[i])) < -depth;
+  return lining.empty() ? 0.0 : double(buried) / double(lining.size());
 }
 
 // The region (sorted keys) with its inside face neighbours.
@@ -59,9 +93,14 @@ MeshMeasures surface_topology(const NarrowBand& band, const ProgressHook& progre
 
 }  // namespace
 
-WebTunnels open_web_tunnels(NarrowBand band, const PointIndex& points, double clearance, const ProgressHook& progress) {
+WebTunnels open_web_tunnels(NarrowBand band, const PointIndex& points, const WebTunnelSettings& s,
+                            const ProgressHook& progress) {
   WebTunnels out;
-  const std::vector<std::uint64_t> air = unsupported_inside(band, points, clearance, progress);
+  const double h = band.voxel_size();
+  const PointIndex& clear_of = s.clearance_points ? *s.clearance_points : points;
+  const std::vector<std::uint64_t> air = unsupported_inside(band, clear_of, s.clearance, progress);
+  // The band's values stop at its half-width: no point reads deeper than that.
+  const double depth = std::min(s.lining_depth, double(band.background()) - h);
   std::vector<std::vector<std::uint64_t>> webs;  // the candidate regions (sorted keys each)
   if (!air.empty()) {
     const std::vector<std::uint32_t> root = label_regions(air);
@@ -80,7 +119,9 @@ WebTunnels open_web_tunnels(NarrowBand band, const PointIndex& points, double cl
         continue;
       members.assign(size[r], 0);
       for (std::uint32_t j = 0; j < size[r]; ++j) members[j] = air[groups.order[groups.start[r] + j]];
-      if (euler_lost(acc, members) == 1) webs.push_back(members);
+      if (euler_lost(acc, members) == 1 &&
+          buried_lining_share(acc, band, points, members, s.clearance + 1.5 * h, depth) < kMinBuriedLining)
+        webs.push_back(members);
     }
   }
   // Each cut is kept only where the surface's own topology (the mesh's) gains exactly one

@@ -51,6 +51,13 @@ std::vector<Vec3d> torus_points() {
   return p;
 }
 
+WebTunnelSettings settings(double h) {
+  WebTunnelSettings s;
+  s.clearance = 2.0 * h;
+  s.lining_depth = 1.5 * h;
+  return s;
+}
+
 bool inside_at(const NarrowBand& band, const Vec3d& x) {
   BandAccessor acc(band);
   const Vec3d q = band.to_index_space(x);
@@ -66,7 +73,7 @@ TEST(WebTunnels, CuttingTheWebAcrossATorussHoleOpensItsHandle) {
   ASSERT_TRUE(inside_at(band, {0, 0, 0}));
   const std::vector<Vec3d> points = torus_points();
   const PointIndex index(points);
-  const WebTunnels r = open_web_tunnels(std::move(band), index, 2.0 * h, {});
+  const WebTunnels r = open_web_tunnels(std::move(band), index, settings(h), {});
   EXPECT_EQ(r.tunnels, 1);
   EXPECT_GT(r.voxels, 100u);
   EXPECT_FALSE(r.bricks.empty());
@@ -99,7 +106,7 @@ TEST(WebTunnels, ASheetThePointsSampleStays) {
         points.push_back({x, y, -0.03});
       }
   const PointIndex index(points);
-  const WebTunnels r = open_web_tunnels(std::move(band), index, 2.0 * h, {});
+  const WebTunnels r = open_web_tunnels(std::move(band), index, settings(h), {});
   EXPECT_EQ(r.tunnels, 0);
   EXPECT_TRUE(inside_at(r.band, {0, 0, 0}));
   EXPECT_EQ(measure_shape(r.band).genus, 0.0);
@@ -117,7 +124,7 @@ TEST(WebTunnels, APartsInteriorBesideAHoleInTheSamplingStays) {
   for (const Vec3d& p : torus_points())
     if (!(p.x > 1.0 && std::abs(p.y) < 0.3)) points.push_back(p);
   const PointIndex index(points);
-  const WebTunnels r = open_web_tunnels(std::move(band), index, 2.0 * h, {});
+  const WebTunnels r = open_web_tunnels(std::move(band), index, settings(h), {});
   EXPECT_EQ(r.tunnels, 0);
   EXPECT_TRUE(inside_at(r.band, {kMajor + 0.2, 0, 0}));
   EXPECT_EQ(measure_shape(r.band).genus, 1.0);
