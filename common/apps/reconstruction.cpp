@@ -28,6 +28,13 @@ using detail::start_shell;
 
 constexpr double kGapClosing = 1.5;
 constexpr double kDenoiseClearanceNoise = 0.5;
+// Webs are cut to open tunnels (ReconstructionOptions::web_tunnels) only under noise of at
+// most this many final voxels: beyond it a web's clear core cannot tell a handle's hole from
+// a narrow gap the noise blurs shut below it (bench_reconstruct --sweep, 0.5 % noise, ~1.8
+// final voxels: diplodocus' tail by its leg genus 0 -> 2 at 20k points and 0 -> 1 at 50k,
+// camel 0 -> 2 at 50k, where anchor_dense at 20k came right, 1 -> 4); at 0.1 % (~0.4) the
+// cuts were the truth's (the elephants' trunk loops at 20k points, 2 -> 3).
+constexpr double kMaxWebTunnelNoise = 0.5;
 constexpr double kDenoiseMaxMove = 2.0;
 // Points this close (relative to the longest side of their box) are one point: float noise
 // of a copy, far below any grid (max_resolution 4096 is 2.4e-4).
@@ -255,7 +262,7 @@ ReconstructionResult reconstruct_surface(const std::vector<Vec3d>& input, const 
       where.carve.pierce = o.pierce_tunnels;
       where.carve.narrow = o.narrow_gaps;
       where.carve.cut_webs = o.cut_webs;
-      where.carve.web_tunnels = o.web_tunnels;
+      where.carve.web_tunnels = o.web_tunnels && result.sampling.noise <= kMaxWebTunnelNoise * h_final;
       where.carve.clearance_points = projected.get();
       where.carve.clearance_noise = projected_noise;
       detail::SnapOutput snapped = detail::snap_level(std::move(band), *index, o, where, std::move(stage), noise);

@@ -162,7 +162,7 @@ struct ReconstructionOptions {
   bool pierce_tunnels = true;   // carve_gaps: a gap lined almost only by buried points may reopen as a tunnel
   bool narrow_gaps = true;      // carve_gaps: a second carving reopens gaps narrower than the sampling gap's clearance
   bool cut_webs = true;         // carve_gaps: sheets of the inside exposed to the outside and clear of every point are cut where that removes a handle
-  bool web_tunnels = true;      // carve_gaps: such sheets spanning a handle's hole (wherever they lie) are cut where that opens one tunnel
+  bool web_tunnels = true;      // carve_gaps: such sheets spanning a handle's hole (wherever they lie) are cut where that opens one tunnel (noise up to half a final voxel)
   bool denoised_clearance = true;  // carve_gaps under noise (sigma > 0.5 final voxels): clearance from points projected onto their planes
   int max_resolution = 4096;    // cap on the final grid's longest side (voxels)
   ProgressHook progress;
