@@ -8,6 +8,8 @@
 //                             columns and blocks of voxels that see the same points;
 //   reconstruction_carve.cpp  gaps the start shell closed reopened where the points sampling
 //                             their walls lie buried inside the surface;
+//   reconstruction_webs.cpp   webs the start shell left across a handle's hole, on no point,
+//                             cut where that opens one tunnel;
 //   reconstruction.cpp        validation, resolution and levels from the data, the levels in
 //                             order, the mesh.
 // Internal to levelset_core (namespace apps::detail). Units: world (the points centred on
@@ -258,8 +260,9 @@ CarveOutput carve_buried_gaps(NarrowBand band, const PointIndex& index, const Ca
 // region (11 voxels) opened two tunnels where the truth has one (genus 2 -> 4: a cut that
 // small does not survive the next level's upsampling as it was); on the final level its 55
 // voxels open one (2 -> 3, the truth's).
-// Cost: one nearest-point query per inside band voxel and the regions' Euler counts; the
-// dig's redistance only where a tunnel opens.
+// Cost: one radius query per inside band voxel beside the outside and per region voxel, the
+// regions' Euler counts; a dig, its redistance and two marching cubes only per region that
+// qualifies.
 inline constexpr std::uint32_t kMinTunnelWebVoxels = 32;
 inline constexpr double kTunnelWebExposure = 0.5;
 struct WebTunnels {

@@ -29,30 +29,35 @@ const Coord kFaceSteps[6] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0
 // voxels beside the outside are tested in parallel, the rest only as the flood reaches them.
 std::vector<std::uint64_t> unsupported_inside(const NarrowBand& band, const PointIndex& points, double clearance,
                                               const ProgressHook& progress) {
-  auto clear = [&](const Coord& c) { return points.nearest(band.world(c)).distance > clearance; };
+  // No point nearer than the clearance (a radius query that stops at the first point found).
+  auto clear = [&](const Coord& c, std::vector<std::pair<std::uint32_t, double>>& scratch) {
+    return points.within(band.world(c), clearance, 0, scratch);
+  };
   std::vector<std::vector<std::uint64_t>> per_brick(band.brick_count());
   tbb::parallel_for(tbb::blocked_range<std::uint32_t>(0, std::uint32_t(band.brick_count()), 16),
                     [&](const tbb::blocked_range<std::uint32_t>& r) {
                       progress.check("reconstruct webs");
                       BandAccessor acc(band);
+                      std::vector<std::pair<std::uint32_t, double>> scratch;
                       for (std::uint32_t b = r.begin(); b != r.end(); ++b)
                         band.for_each_active_in_brick(b, [&](const Coord& c, float v) {
                           if (v >= 0.0f) return;
                           bool exposed = false;
                           for (const Coord& step : kFaceSteps) exposed = exposed || !acc.is_inside(c + step);
-                          if (exposed && clear(c)) per_brick[b].push_back(key_of(c));
+                          if (exposed && clear(c, scratch)) per_brick[b].push_back(key_of(c));
                         });
                     });
   std::vector<std::uint64_t> keys;
   for (const auto& k : per_brick) keys.insert(keys.end(), k.begin(), k.end());
   std::unordered_set<std::uint64_t> seen(keys.begin(), keys.end());
   BandAccessor acc(band);
+  std::vector<std::pair<std::uint32_t, double>> scratch;
   for (std::size_t at = 0; at < keys.size(); ++at)
     for (const Coord& step : kFaceSteps) {
       const Coord q = coord_of(keys[at]) + step;
       if (!seen.insert(key_of(q)).second) continue;
       const std::optional<float> u = acc.probe(q);
-      if (u && *u < 0.0f && clear(q)) keys.push_back(key_of(q));
+      if (u && *u < 0.0f && clear(q, scratch)) keys.push_back(key_of(q));
     }
   std::sort(keys.begin(), keys.end());
   return keys;
