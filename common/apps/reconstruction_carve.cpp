@@ -175,6 +175,18 @@ NarrowBand with_active(const NarrowBand& band, const std::vector<std::uint64_t>&
 
 // Empty space farther than this from every point may be carved.
 // The noise the clearance allows for is that of the points it is measured from.
+// A lining point deeper than this (world) inside the front is buried.
+double lining_depth_of(const CarveSettings& s, double h) {
+  return std::max(kCarveDepthVoxels * h, kLiningNoiseDepth * s.noise);
+}
+
+// `more` brick keys merged into the sorted `into`.
+void merge_bricks(std::vector<std::uint64_t>& into, const std::vector<std::uint64_t>& more) {
+  into.insert(into.end(), more.begin(), more.end());
+  std::sort(into.begin(), into.end());
+  into.erase(std::unique(into.begin(), into.end()), into.end());
+}
+
 double clearance_of(const CarveSettings& s, double h) {
   const double noise = s.clearance_points ? s.clearance_noise : s.noise;
   return std::max({h, kCarveNoiseDepth * noise, s.gap});
@@ -528,7 +540,7 @@ CarveOutput carve_once(NarrowBand band, const PointIndex& index, const CarveSett
   const double h = band.voxel_size();
   const double depth = std::max(kCarveDepthVoxels * h, kCarveNoiseDepth * s.noise);
   const double clearance = clearance_of(s, h);
-  const double lining_depth = std::max(kCarveDepthVoxels * h, kLiningNoiseDepth * s.noise);
+  const double lining_depth = lining_depth_of(s, h);
   const std::vector<float> value = point_values(band, index, std::max(depth, lining_depth));
   const std::vector<std::uint32_t> buried = deeper_than(value, depth);
   out.buried = buried.size();
@@ -562,15 +574,13 @@ CarveOutput carve_buried_gaps(NarrowBand band, const PointIndex& index, const Ca
   if (s.web_tunnels) {
     WebTunnelSettings ws;
     ws.clearance = clearance_of(s, h);
-    ws.lining_depth = std::max(kCarveDepthVoxels * h, kLiningNoiseDepth * s.noise);
+    ws.lining_depth = lining_depth_of(s, h);
     ws.clearance_points = s.clearance_points;
     WebTunnels webs = open_web_tunnels(std::move(out.band), index, ws, progress);
     out.band = std::move(webs.band);
     out.web_tunnels = webs.tunnels;
     out.carved_voxels += webs.voxels;
-    out.bricks.insert(out.bricks.end(), webs.bricks.begin(), webs.bricks.end());
-    std::sort(out.bricks.begin(), out.bricks.end());
-    out.bricks.erase(std::unique(out.bricks.begin(), out.bricks.end()), out.bricks.end());
+    merge_bricks(out.bricks, webs.bricks);
   }
   if (!s.narrow) return out;
   // The narrow gaps (see kNarrowGapClearance), after the wide ones are open: simple flips only.
@@ -584,9 +594,7 @@ CarveOutput carve_buried_gaps(NarrowBand band, const PointIndex& index, const Ca
   out.band = std::move(more.band);
   out.regions += more.regions;
   out.carved_voxels += more.carved_voxels;
-  out.bricks.insert(out.bricks.end(), more.bricks.begin(), more.bricks.end());
-  std::sort(out.bricks.begin(), out.bricks.end());
-  out.bricks.erase(std::unique(out.bricks.begin(), out.bricks.end()), out.bricks.end());
+  merge_bricks(out.bricks, more.bricks);
   return out;
 }
 

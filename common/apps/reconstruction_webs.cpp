@@ -23,6 +23,12 @@ namespace {
 
 const Coord kFaceSteps[6] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
 
+bool beside_outside(BandAccessor& acc, const Coord& c) {
+  for (const Coord& step : kFaceSteps)
+    if (!acc.is_inside(c + step)) return true;
+  return false;
+}
+
 // The band's active inside voxels farther than `clearance` from every point that are
 // connected (6-neighbours, through such voxels) to one beside the outside (sorted keys): the
 // components of those voxels that could be a sheet (the others are exposed nowhere). The
@@ -41,10 +47,8 @@ std::vector<std::uint64_t> unsupported_inside(const NarrowBand& band, const Poin
                       std::vector<std::pair<std::uint32_t, double>> scratch;
                       for (std::uint32_t b = r.begin(); b != r.end(); ++b)
                         band.for_each_active_in_brick(b, [&](const Coord& c, float v) {
-                          if (v >= 0.0f) return;
-                          bool exposed = false;
-                          for (const Coord& step : kFaceSteps) exposed = exposed || !acc.is_inside(c + step);
-                          if (exposed && clear(c, scratch)) per_brick[b].push_back(key_of(c));
+                          if (v < 0.0f && beside_outside(acc, c) && clear(c, scratch))
+                            per_brick[b].push_back(key_of(c));
                         });
                     });
   std::vector<std::uint64_t> keys;
@@ -114,9 +118,7 @@ WebTunnels open_web_tunnels(NarrowBand band, const PointIndex& points, const Web
     std::vector<std::uint32_t> size(air.size(), 0), exposed(air.size(), 0);
     for (std::size_t i = 0; i < air.size(); ++i) {
       ++size[root[i]];
-      bool open = false;
-      for (const Coord& step : kFaceSteps) open = open || !acc.is_inside(coord_of(air[i]) + step);
-      exposed[root[i]] += open;
+      exposed[root[i]] += beside_outside(acc, coord_of(air[i]));
     }
     std::vector<std::uint64_t> members;
     for (std::size_t r = 0; r < air.size(); ++r) {
