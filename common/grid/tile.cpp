@@ -192,14 +192,26 @@ void gather_box(const NarrowBand& band, std::uint32_t brick, int lo, int hi, std
 
 namespace {
 
-// Copies `width` floats (8: two vector moves, no memmove call for so short a run).
+// Copies `width` (<= 8) floats: a fixed-size copy per width, a few moves each (a loop of
+// runtime length became vector code with overlap checks and a scalar tail: the halos' rows of
+// 3 cost more than the brick's rows of 8).
+template <int N>
+inline void copy_floats(const float* src, float* dst) {
+  std::array<float, N> row;
+  std::memcpy(row.data(), src, sizeof row);
+  std::memcpy(dst, row.data(), sizeof row);
+}
 inline void copy_row(const float* src, float* dst, int width) {
-  if (width == kBrickDim) {
-    std::array<float, kBrickDim> row;
-    std::memcpy(row.data(), src, sizeof row);
-    std::memcpy(dst, row.data(), sizeof row);
-  } else {
-    for (int x = 0; x < width; ++x) dst[x] = src[x];
+  switch (width) {
+    case 8: return copy_floats<8>(src, dst);
+    case 7: return copy_floats<7>(src, dst);
+    case 6: return copy_floats<6>(src, dst);
+    case 5: return copy_floats<5>(src, dst);
+    case 4: return copy_floats<4>(src, dst);
+    case 3: return copy_floats<3>(src, dst);
+    case 2: return copy_floats<2>(src, dst);
+    case 1: return copy_floats<1>(src, dst);
+    default: return;
   }
 }
 
