@@ -77,11 +77,13 @@ bool curvature_stencil_active(const Scratch& s, const Coord& p) {
 // smallest |u|, at most 3 steps). Level sets of a distance function are parallel, so that
 // is the curvature of a neighbouring level set, off by O(h k^2); a garbage curvature here
 // fed the parabolic part with rates of 1 / h and made the band drift and grow (issue 13).
-// -1 (no curvature) where no such voxel is near (a band too thin for the stencil).
+// -1 (no curvature) where no such voxel is near (a band too thin for the stencil). For voxels
+// whose own stencil is not whole (Scratch::whole, which the caller read): the first test is
+// skipped.
 int curvature_source(const Scratch& s, const Coord& l) {
   Coord p = l;
   for (int hop = 0;; ++hop) {
-    if (curvature_stencil_active(s, p)) return tile_index(p.x, p.y, p.z);
+    if (hop > 0 && curvature_stencil_active(s, p)) return tile_index(p.x, p.y, p.z);
     if (hop == 3) return -1;
     const float here = std::abs(s.tile[std::size_t(tile_index(p.x, p.y, p.z))]);
     Coord best = p;
