@@ -576,6 +576,8 @@ CarveOutput carve_buried_gaps(NarrowBand band, const PointIndex& index, const Ca
     ws.clearance = clearance_of(s, h);
     ws.lining_depth = lining_depth_of(s, h);
     ws.clearance_points = s.clearance_points;
+    ws.fine_clearance = s.fine_tunnels ? kFineTunnelClearance * ws.clearance : 0.0;
+    ws.shallow_depth = std::max(kShallowLiningVoxels * h, kLiningNoiseDepth * s.noise);
     WebTunnels webs = open_web_tunnels(std::move(out.band), index, ws, progress);
     out.band = std::move(webs.band);
     out.web_tunnels = webs.tunnels;

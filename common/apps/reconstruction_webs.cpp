@@ -100,58 +100,74 @@ MeshMeasures surface_topology(const NarrowBand& band, const ProgressHook& progre
   return measure_mesh(marching_cubes(band, mc).mesh);
 }
 
-}  // namespace
+// What makes a region of clear voxels a web: its clearance (world), its smallest size, and
+// for the fine pass its share of lining points below the surface.
+struct WebRule {
+  double clearance = 0.0;
+  std::uint32_t min_voxels = kMinTunnelWebVoxels;
+  double shallow_depth = 0.0;  // world; with min_shallow > 0
+  double min_shallow = 0.0;
+};
 
-WebTunnels open_web_tunnels(NarrowBand band, const PointIndex& points, const WebTunnelSettings& s,
-                            const ProgressHook& progress) {
-  WebTunnels out;
+// The regions of clear inside voxels (sorted keys each) that are webs under `rule` (see
+// reconstruction_parts.hpp).
+std::vector<std::vector<std::uint64_t>> find_webs(const NarrowBand& band, const PointIndex& points,
+                                                  const PointIndex& clear_of, double lining_depth, const WebRule& rule,
+                                                  const ProgressHook& progress) {
+  std::vector<std::vector<std::uint64_t>> webs;
   const double h = band.voxel_size();
-  const PointIndex& clear_of = s.clearance_points ? *s.clearance_points : points;
-  const std::vector<std::uint64_t> air = unsupported_inside(band, clear_of, s.clearance, progress);
+  const std::vector<std::uint64_t> air = unsupported_inside(band, clear_of, rule.clearance, progress);
+  if (air.empty()) return webs;
   // The band's values stop at its half-width: no point reads deeper than that.
-  const double depth = std::min(s.lining_depth, double(band.background()) - h);
-  std::vector<std::vector<std::uint64_t>> webs;  // the candidate regions (sorted keys each)
-  if (!air.empty()) {
-    const std::vector<std::uint32_t> root = label_regions(air);
-    const RegionGroups groups = group_by_region(root);
-    BandAccessor acc(band);
-    std::vector<std::uint32_t> size(air.size(), 0), exposed(air.size(), 0);
-    for (std::size_t i = 0; i < air.size(); ++i) {
-      ++size[root[i]];
-      exposed[root[i]] += beside_outside(acc, coord_of(air[i]));
-    }
-    std::vector<std::uint64_t> members;
-    for (std::size_t r = 0; r < air.size(); ++r) {
-      if (root[r] != r || size[r] < kMinTunnelWebVoxels || double(exposed[r]) < kTunnelWebExposure * double(size[r]))
-        continue;
-      members.assign(size[r], 0);
-      for (std::uint32_t j = 0; j < size[r]; ++j) members[j] = air[groups.order[groups.start[r] + j]];
-      if (euler_lost(acc, members) == 1 &&
-          buried_lining_share(acc, band, points, members, s.clearance + 1.5 * h, depth) < kMinBuriedLining)
-        webs.push_back(members);
-    }
+  const double depth = std::min(lining_depth, double(band.background()) - h);
+  const double reach = rule.clearance + 1.5 * h;
+  const std::vector<std::uint32_t> root = label_regions(air);
+  const RegionGroups groups = group_by_region(root);
+  BandAccessor acc(band);
+  std::vector<std::uint32_t> size(air.size(), 0), exposed(air.size(), 0);
+  for (std::size_t i = 0; i < air.size(); ++i) {
+    ++size[root[i]];
+    exposed[root[i]] += beside_outside(acc, coord_of(air[i]));
   }
-  // Each cut is kept only where the surface's own topology (the mesh's) gains exactly one
-  // handle: the voxels' Euler count is the inside's 6-connected complex, and where the cut
-  // leaves the web's rim touching itself across a voxel's diagonal, the marching cubes join
-  // what the count separates (CGAL's elephant at 20k points, one sample set: genus 2 -> 4).
-  // There the web grown by one voxel (its rim too, which the snaps after the carving put
-  // back on the points) is tried instead.
-  MeshMeasures before = webs.empty() ? MeshMeasures{} : surface_topology(band, progress);
+  std::vector<std::uint64_t> members;
+  for (std::size_t r = 0; r < air.size(); ++r) {
+    if (root[r] != r || size[r] < rule.min_voxels || double(exposed[r]) < kTunnelWebExposure * double(size[r]))
+      continue;
+    members.assign(size[r], 0);
+    for (std::uint32_t j = 0; j < size[r]; ++j) members[j] = air[groups.order[groups.start[r] + j]];
+    if (euler_lost(acc, members) != 1 || buried_lining_share(acc, band, points, members, reach, depth) >= kMinBuriedLining)
+      continue;
+    if (rule.min_shallow > 0.0 &&
+        buried_lining_share(acc, band, points, members, reach, rule.shallow_depth) < rule.min_shallow)
+      continue;
+    webs.push_back(members);
+  }
+  return webs;
+}
+
+// Each cut is kept only where the surface's own topology (the mesh's) gains exactly one
+// handle: the voxels' Euler count is the inside's 6-connected complex, and where the cut
+// leaves the web's rim touching itself across a voxel's diagonal, the marching cubes join
+// what the count separates (CGAL's elephant at 20k points, one sample set: genus 2 -> 4).
+// There the web grown by one voxel (its rim too, which the snaps after the carving put
+// back on the points) is tried instead.
+void cut_webs(std::vector<std::vector<std::uint64_t>>& webs, const ProgressHook& progress, WebTunnels& out) {
+  if (webs.empty()) return;
+  MeshMeasures before = surface_topology(out.band, progress);
   for (std::vector<std::uint64_t>& web : webs) {
     for (int attempt = 0; attempt < 2; ++attempt) {
       if (attempt == 1) {
-        BandAccessor acc(band);
+        BandAccessor acc(out.band);
         web = grown_inside(acc, web);
         if (euler_lost(acc, web) != 1) break;
       }
       RegionChoice choice;
       choice.carved = choice.pierced = web;
       choice.regions = choice.pierced_regions = 1;
-      Dug dug = dig_regions(band, choice, progress);
+      Dug dug = dig_regions(out.band, choice, progress);
       const MeshMeasures after = surface_topology(dug.band, progress);
       if (after.components != before.components || after.genus != before.genus + 1.0 || !after.watertight) continue;
-      band = std::move(dug.band);
+      out.band = std::move(dug.band);
       before = after;
       ++out.tunnels;
       out.voxels += dug.carved_voxels;
@@ -159,9 +175,32 @@ WebTunnels open_web_tunnels(NarrowBand band, const PointIndex& points, const Web
       break;
     }
   }
+}
+
+}  // namespace
+
+WebTunnels open_web_tunnels(NarrowBand band, const PointIndex& points, const WebTunnelSettings& s,
+                            const ProgressHook& progress) {
+  WebTunnels out;
+  out.band = std::move(band);
+  const PointIndex& clear_of = s.clearance_points ? *s.clearance_points : points;
+  WebRule wide;
+  wide.clearance = s.clearance;
+  std::vector<std::vector<std::uint64_t>> webs = find_webs(out.band, points, clear_of, s.lining_depth, wide, progress);
+  cut_webs(webs, progress, out);
+  if (s.fine_clearance > 0.0 && s.fine_clearance < s.clearance) {
+    // Holes too narrow for the clearance (turbine's bolt holes, ~5 voxels across): their
+    // walls' points lie inside the plug the shell left, below the surface (see the header).
+    WebRule fine;
+    fine.clearance = s.fine_clearance;
+    fine.min_voxels = kMinFineTunnelVoxels;
+    fine.shallow_depth = s.shallow_depth;
+    fine.min_shallow = kMinShallowLining;
+    webs = find_webs(out.band, points, clear_of, s.lining_depth, fine, progress);
+    cut_webs(webs, progress, out);
+  }
   std::sort(out.bricks.begin(), out.bricks.end());
   out.bricks.erase(std::unique(out.bricks.begin(), out.bricks.end()), out.bricks.end());
-  out.band = std::move(band);
   return out;
 }
 

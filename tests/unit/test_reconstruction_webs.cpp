@@ -1,6 +1,8 @@
 // Tunnels through webs (reconstruction_parts.hpp open_web_tunnels): a sheet of the inside
 // that spans a handle's hole and lies on no point is cut, which opens the handle; a part's
-// interior beside a hole in the sampling, and a sheet the points sample, stay.
+// interior beside a hole in the sampling, and a sheet the points sample, stay. The fine pass
+// opens a hole narrower than the clearance through a thin plate, whose wall's points lie in
+// the plug below the surface, and leaves a plate whose sampling has a hole of the same size.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -128,6 +130,85 @@ TEST(WebTunnels, APartsInteriorBesideAHoleInTheSamplingStays) {
   EXPECT_EQ(r.tunnels, 0);
   EXPECT_TRUE(inside_at(r.band, {kMajor + 0.2, 0, 0}));
   EXPECT_EQ(measure_shape(r.band).genus, 1.0);
+}
+
+// A square plate |x|, |y| <= 1, |z| <= 1.5 h (three voxel layers at resolution 64 of its box)
+// as the start shell leaves it: whole, any hole in it filled.
+constexpr double kPlateVoxels = 64;
+constexpr double kHole = 3.5;  // the hole's radius, voxels
+NarrowBand filled_plate(double& h) {
+  BBox box;
+  box.extend({-1, -1, -0.2});
+  box.extend({1, 1, 0.2});
+  SdfBuildOptions options;
+  options.frame = frame_for_resolution(box, int(kPlateVoxels), 3.0);
+  h = options.frame.voxel_size;
+  const double t = 1.5 * h;
+  auto sdf = [t](const Vec3d& p) { return std::max({std::abs(p.x) - 1.0, std::abs(p.y) - 1.0, std::abs(p.z) - t}); };
+  return build_from_sdf(sdf, box, options).band;
+}
+
+// Points on the plate's two faces, spacing h / 3, except within `hole` of the z axis; with
+// `wall`, also on the cylinder of that radius between the faces (a hole through the plate).
+std::vector<Vec3d> plate_points(double h, double hole, bool wall) {
+  std::vector<Vec3d> p;
+  const double t = 1.5 * h, step = h / 3.0;
+  for (double x = -0.5; x <= 0.5; x += step)
+    for (double y = -0.5; y <= 0.5; y += step)
+      if (std::hypot(x, y) >= hole) {
+        p.push_back({x, y, t});
+        p.push_back({x, y, -t});
+      }
+  if (wall)
+    for (double z = -t; z <= t; z += step)
+      for (int k = 0; k < 64; ++k) {
+        const double a = 2 * std::numbers::pi * k / 64;
+        p.push_back({hole * std::cos(a), hole * std::sin(a), z});
+      }
+  return p;
+}
+
+// The plate's settings: a clearance whose fine pass's (2 h) exceeds the plate's half-thickness,
+// so that only the hole's core is clear of the points.
+WebTunnelSettings fine_settings(double h) {
+  WebTunnelSettings s = settings(h);
+  s.clearance = 4.0 * h;
+  s.fine_clearance = kFineTunnelClearance * s.clearance;
+  s.shallow_depth = kShallowLiningVoxels * h;
+  return s;
+}
+
+TEST(WebTunnels, TheFinePassOpensAHoleNarrowerThanTheClearanceThroughAThinPlate) {
+  double h = 0;
+  NarrowBand band = filled_plate(h);
+  EXPECT_EQ(measure_shape(band).genus, 0.0);
+  const PointIndex index(plate_points(h, kHole * h, true));
+  // The wide pass alone: the hole's core is within the clearance of its wall.
+  WebTunnelSettings wide_only = fine_settings(h);
+  wide_only.fine_clearance = 0.0;
+  const WebTunnels wide = open_web_tunnels(band, index, wide_only, {});
+  EXPECT_EQ(wide.tunnels, 0);
+  EXPECT_EQ(measure_shape(wide.band).genus, 0.0);
+  const WebTunnels r = open_web_tunnels(std::move(band), index, fine_settings(h), {});
+  EXPECT_EQ(r.tunnels, 1);
+  EXPECT_FALSE(inside_at(r.band, {0, 0, 0}));
+  EXPECT_TRUE(inside_at(r.band, {0.3, 0.3, 0}));
+  const ShapeMeasures m = measure_shape(r.band);
+  EXPECT_TRUE(m.watertight);
+  EXPECT_EQ(m.components, 1u);
+  EXPECT_EQ(m.genus, 1.0);
+}
+
+TEST(WebTunnels, TheFinePassLeavesAPlateWhoseSamplingHasAHole) {
+  // The same plate whole, its points missing on both faces within kHole h of the axis and no
+  // wall: the voxels there are as clear, but the points around them lie on the surface.
+  double h = 0;
+  NarrowBand band = filled_plate(h);
+  const PointIndex index(plate_points(h, kHole * h, false));
+  const WebTunnels r = open_web_tunnels(std::move(band), index, fine_settings(h), {});
+  EXPECT_EQ(r.tunnels, 0);
+  EXPECT_TRUE(inside_at(r.band, {0, 0, 0}));
+  EXPECT_EQ(measure_shape(r.band).genus, 0.0);
 }
 
 }  // namespace
