@@ -37,9 +37,10 @@ constexpr double kDenoiseClearanceNoise = 0.5;
 constexpr double kMaxWebTunnelNoise = 0.5;
 // The web tunnels' fine pass (reconstruction_parts.hpp) only on the final level and on points
 // this clean (final voxels): measured on the clean sweep rows only (their noise reads
-// 0.03-0.1 voxel; 0.1 % of a diagonal is at least 0.256 final voxels). On the middle level a hole in the sampling of
-// rotor_small's thin blades (50k points) read 0.26 of its lining below the surface, among
-// turbine's bolt holes' 0.24-0.32, and its cut made a handle the truth does not have.
+// 0.03-0.1 voxel; 0.1 % of a diagonal is at least 0.256 final voxels at R = 256). On the
+// middle level a hole in the sampling of rotor_small's thin blades (50k points) read 0.26 of
+// its lining below the surface, among turbine's bolt holes' 0.24-0.32, and its cut made a
+// handle the truth does not have.
 constexpr double kMaxFineTunnelNoise = 0.15;
 constexpr double kDenoiseMaxMove = 2.0;
 // Points this close (relative to the longest side of their box) are one point: float noise

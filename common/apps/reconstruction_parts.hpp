@@ -261,17 +261,18 @@ CarveOutput carve_buried_gaps(NarrowBand band, const PointIndex& index, const Ca
 // region (11 voxels) opened two tunnels where the truth has one (genus 2 -> 4: a cut that
 // small does not survive the next level's upsampling as it was); on the final level its 55
 // voxels open one (2 -> 3, the truth's).
-// Fine pass (settings.fine_clearance > 0: on the final level, on points with noise of at most
-// 0.15 final voxels, reconstruction.cpp): a hole narrower than about twice the clearance through a thin
-// plate (CGAL's turbine: bolt holes ~5 final voxels across in a plate ~3 thick) leaves no
-// voxel that far from its wall's points, and its plug holds too few buried points for the
-// carving (24 at 50k points, below kMinBuriedShare N). The same search runs again after the
-// first with kFineTunnelClearance of the clearance and regions of kMinFineTunnelVoxels, and
-// a region is cut only where at least kMinShallowLining of its lining lies deeper than
-// settings.shallow_depth (max(kShallowLiningVoxels h, 2 noise)) below the surface: the hole's
-// wall inside the plug (turbine 0.47-0.65 on the final level at 0.5 h), where a hole in the sampling of a thin
-// part is lined by its faces' points, on the surface (bones.off, clean 20k points: 0-0.08,
-// which cut raised its genus 13 -> 16 against the truth's 0).
+// Fine pass (settings.fine_clearance > 0: on the final level, on points with noise of at
+// most 0.15 final voxels, reconstruction.cpp): a hole narrower than about twice the
+// clearance through a thin plate (CGAL's turbine: bolt holes ~5 final voxels across in a
+// plate ~3 thick) leaves no voxel that far from its wall's points, and its plug holds too
+// few buried points for the carving (24 at 50k points, below kMinBuriedShare N). The same
+// search runs again after the first with kFineTunnelClearance of the clearance and regions
+// of kMinFineTunnelVoxels, and a region is cut only where at least kMinShallowLining of its
+// lining lies deeper than settings.shallow_depth (max(kShallowLiningVoxels h, 2 noise))
+// below the surface: the hole's wall inside the plug (turbine 0.47-0.65 on the final level
+// at 0.5 h), where a hole in the sampling of a thin part is lined by its faces' points, on
+// the surface (bones.off, clean 20k points: 0-0.08, which cuts raised its genus 13 -> 16
+// against the truth's 0).
 // Cost: one radius query per inside band voxel beside the outside and per region voxel, the
 // regions' Euler counts; a dig, its redistance and two marching cubes only per region that
 // qualifies; the fine pass as much again.

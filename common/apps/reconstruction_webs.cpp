@@ -67,19 +67,30 @@ std::vector<std::uint64_t> unsupported_inside(const NarrowBand& band, const Poin
   return keys;
 }
 
-// The share of a region's lining (the points within `reach` of its voxels) deeper than
-// `depth` inside the surface (the band's values).
-double buried_lining_share(BandAccessor& acc, const NarrowBand& band, const PointIndex& points,
-                           const std::vector<std::uint64_t>& region, double reach, double depth) {
+// The shares of a region's lining (the points within `reach` of its voxels) deeper than
+// `buried` and than `shallow` inside the surface (the band's values), from one gathering.
+struct LiningShares {
+  double buried = 0.0, shallow = 0.0;
+};
+LiningShares lining_shares(BandAccessor& acc, const NarrowBand& band, const PointIndex& points,
+                           const std::vector<std::uint64_t>& region, double reach, double buried, double shallow) {
   std::unordered_set<std::uint32_t> lining;
   std::vector<std::pair<std::uint32_t, double>> near;
   for (const std::uint64_t k : region) {
     points.within(band.world(coord_of(k)), reach, near);
     for (const auto& [i, d2] : near) lining.insert(i);
   }
-  std::size_t buried = 0;
-  for (const std::uint32_t i : lining) buried += double(sample_trilinear(acc, band, points.points()[i])) < -depth;
-  return lining.empty() ? 0.0 : double(buried) / double(lining.size());
+  LiningShares out;
+  if (lining.empty()) return out;
+  std::size_t deep = 0, below = 0;
+  for (const std::uint32_t i : lining) {
+    const double u = double(sample_trilinear(acc, band, points.points()[i]));
+    deep += u < -buried;
+    below += u < -shallow;
+  }
+  out.buried = double(deep) / double(lining.size());
+  out.shallow = double(below) / double(lining.size());
+  return out;
 }
 
 // The region (sorted keys) with its inside face neighbours.
@@ -135,11 +146,9 @@ std::vector<std::vector<std::uint64_t>> find_webs(const NarrowBand& band, const 
       continue;
     members.assign(size[r], 0);
     for (std::uint32_t j = 0; j < size[r]; ++j) members[j] = air[groups.order[groups.start[r] + j]];
-    if (euler_lost(acc, members) != 1 || buried_lining_share(acc, band, points, members, reach, depth) >= kMinBuriedLining)
-      continue;
-    if (rule.min_shallow > 0.0 &&
-        buried_lining_share(acc, band, points, members, reach, rule.shallow_depth) < rule.min_shallow)
-      continue;
+    if (euler_lost(acc, members) != 1) continue;
+    const LiningShares lining = lining_shares(acc, band, points, members, reach, depth, rule.shallow_depth);
+    if (lining.buried >= kMinBuriedLining || (rule.min_shallow > 0.0 && lining.shallow < rule.min_shallow)) continue;
     webs.push_back(members);
   }
   return webs;
