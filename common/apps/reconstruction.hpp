@@ -94,7 +94,9 @@
 //   p = 2 flow's fixed point reached in one step (the flow with the gain g = 2 / dt is the
 //   snap), valid because the upsampled coarse front lies within about a voxel of the data.
 //   Passes (snap_passes per level; on the final level at least clean_final_passes when the
-//   first pass found the data clean: the second pass refits along the corrected normals)
+//   first pass found the data clean: the second pass refits along the corrected normals;
+//   noisy data there, refit_moved: one more pass on the bricks whose voxels the last pass moved
+//   more than 0.1 voxel on average, where one pass of neighbourhood-averaged offsets stops short)
 //   stop early when the mean |change| of the snapped voxels is below tolerance. A level's
 //   first pass may run before any level has read the noise; where its reading asks for 4 times
 //   the height fits' points or more, the final level, and a level whose fits read more noise
@@ -154,6 +156,7 @@ struct ReconstructionOptions {
   int max_steps = 120;          // coarsest level's flow
   int snap_passes = 1;          // per finer level (noisy data: more drift, 1 measured best)
   int clean_final_passes = 2;   // final level, clean data (second-order snaps): at least this many
+  bool refit_moved = true;      // final level, noisy data: one more pass on the bricks the last one moved far
   double tolerance = 0.01;      // voxels: flow: mean front motion per step; snap: mean change
   bool guard_flow = true;        // coarsest flow: refuse sign changes that change the topology (slower)
   bool guard_snaps = true;      // snaps: the same
@@ -190,6 +193,7 @@ struct ReconstructionStage {
   int pierced_regions = 0;          // of them reopened whole, tunnels allowed (pierce_tunnels), or webs cut
   int webs_cut = 0;                 // of those, webs (cut_webs)
   int web_tunnels = 0;              // finer levels: webs spanning a handle's hole cut, one tunnel each (web_tunnels)
+  std::uint64_t refit_bricks = 0;   // final level, noisy data: bricks that took one more snap pass (refit_moved)
   std::uint64_t carved_voxels = 0;
   std::uint64_t active_voxels = 0;
   std::uint64_t fit_voxels = 0; // local fits computed (cache, or snapped voxels of all passes)

@@ -450,5 +450,6 @@ TEST(Reconstruction, BadInputsGiveTypedErrors) {
   EXPECT_EQ(code(four, clean_passes), ErrorCode::InvalidArgument);
 }
 
+
 }  // namespace
 }  // namespace levelset::apps

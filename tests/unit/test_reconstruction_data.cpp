@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <random>
 
@@ -425,6 +426,38 @@ TEST(Reconstruction, DigsOutACavityBehindANarrowOpening) {
   double worst = 0.0;
   for (const Vec3d& v : homer.truth.vertices) worst = std::max(worst, ours.distance(v));
   EXPECT_LT(worst, 0.015);  // 3.7 voxels
+}
+
+// The symmetric mean distance (Chamfer) between a reconstruction and the true mesh, world.
+double chamfer_to(const ReconstructionResult& r, const TriangleMesh& truth) {
+  SurfaceSampleOptions dense;
+  dense.count = 50000;
+  dense.seed = 7;
+  const MeshDistance to_ours(r.mesh), to_truth(truth);
+  return surface_distance(
+             sample_mesh_surface(truth, dense), [&](const Vec3d& p) { return to_ours.distance(p); },
+             sample_mesh_surface(r.mesh, dense), [&](const Vec3d& p) { return to_truth.distance(p); })
+      .chamfer;
+}
+
+TEST(Reconstruction, NoisyDetailTakesOneMorePassWhereTheFrontMovedFar) {
+  // CGAL's cow (legs, ears, horns a few voxels across) from 20k points, noise 0.1 % of the
+  // diagonal (about half a final voxel: the noisy snap route), resolution 256. One snap pass
+  // of neighbourhood-averaged offsets stops short where the middle level could not follow
+  // the shape; the final level's pass on the bricks it moved far (refit_moved) closes much of
+  // that: Chamfer 5.7 % lower measured, from 163 of 1807 bricks (bench_reconstruct --sweep's
+  // points: 0.654 -> 0.616 of Poisson's).
+  const CgalCase cow = cgal_case("cow.off", 20000);
+  const OnAndOff r = with_and_without(cow.points, [](ReconstructionOptions& o) { o.refit_moved = false; });
+  const ReconstructionStage& on = r.on.stages.back();
+  EXPECT_FALSE(on.second_order);
+  EXPECT_GT(on.refit_bricks, 0u);
+  EXPECT_LT(double(on.refit_bricks), 0.3 * double(r.on.band.brick_count()));
+  EXPECT_EQ(r.off.stages.back().refit_bricks, 0u);
+  const double with = chamfer_to(r.on, cow.truth), without = chamfer_to(r.off, cow.truth);
+  std::printf("    chamfer %.4g with, %.4g without; %llu of %zu bricks\n", with, without, (unsigned long long)on.refit_bricks, r.on.band.brick_count());
+  EXPECT_LT(with, 0.97 * without) << with << " against " << without;
+  EXPECT_EQ(r.on.measures.genus, 0.0);
 }
 
 }  // namespace
