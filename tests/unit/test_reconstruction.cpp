@@ -450,6 +450,5 @@ TEST(Reconstruction, BadInputsGiveTypedErrors) {
   EXPECT_EQ(code(four, clean_passes), ErrorCode::InvalidArgument);
 }
 
-
 }  // namespace
 }  // namespace levelset::apps
