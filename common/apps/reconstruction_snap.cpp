@@ -515,10 +515,9 @@ SnapOutput snap_level(NarrowBand band, const PointIndex& index, const Reconstruc
   auto settings_for = [&](bool refine) {
     return snap_settings(o, band, index.size(), {previous_noise, previous_height_noise}, h, h_final, refine);
   };
-  for (int pass = 0; !carved_bricks.empty() && pass < kPassesAfterCarving; ++pass) {
+  // A pass on some bricks (settings.only), then the redistance (the front moved by up to a voxel).
+  auto pass_on_bricks = [&](const SnapSettings& settings) {
     const auto t_fit = Clock::now();
-    SnapSettings settings = settings_for(false);
-    settings.only = &carved_bricks;
     const SnapPass snapped = snap_to_fits(band, index, settings, coarse, coarse_curvature, o.progress);
     stage.refused_flips += snapped.refused;
     stage.fit_voxels += snapped.voxels;
@@ -527,6 +526,11 @@ SnapOutput snap_level(NarrowBand band, const PointIndex& index, const Reconstruc
     const auto t_redistance = Clock::now();
     band = redistanced(band, W, 1.0, o.progress);
     stage.seconds_redistance += seconds_since(t_redistance);
+  };
+  for (int pass = 0; !carved_bricks.empty() && pass < kPassesAfterCarving; ++pass) {
+    SnapSettings settings = settings_for(false);
+    settings.only = &carved_bricks;
+    pass_on_bricks(settings);
   }
   // On the final level, clean data get clean_final_passes (the first pass's noise
   // estimate decides).
@@ -601,20 +605,12 @@ SnapOutput snap_level(NarrowBand band, const PointIndex& index, const Reconstruc
   // Noisy data, final level: where the last pass moved the front far, one more pass on those
   // bricks (refit_moved, kRefitChange).
   if (level == levels - 1 && !last_pass.clean && !last_pass.moved.empty() && previous_height_noise <= kReferenceNoise) {
-    const auto t_fit = Clock::now();
     SnapSettings settings = settings_for(false);
     settings.only = &last_pass.moved;
     settings.fixed_sigma = last_pass.noise;
     settings.fixed_residual = last_pass.height_noise * h;
-    const SnapPass snapped = snap_to_fits(band, index, settings, coarse, coarse_curvature, o.progress);
+    pass_on_bricks(settings);
     stage.refit_bricks = last_pass.moved.size();
-    stage.refused_flips += snapped.refused;
-    stage.fit_voxels += snapped.voxels;
-    stage.fit_models += snapped.models;
-    stage.seconds_fit += seconds_since(t_fit);
-    const auto t_redistance = Clock::now();
-    band = redistanced(band, W, 1.0, o.progress);
-    stage.seconds_redistance += seconds_since(t_redistance);
   }
   if (level > 0) stage.converged = stage.last_change < o.tolerance;
   return {std::move(band), std::move(stage), {previous_noise, previous_height_noise}};
