@@ -95,8 +95,9 @@
 //   snap), valid because the upsampled coarse front lies within about a voxel of the data.
 //   Passes (snap_passes per level; on the final level at least clean_final_passes when the
 //   first pass found the data clean: the second pass refits along the corrected normals;
-//   noisy data there, refit_moved: one more pass on the bricks whose voxels the last pass moved
-//   more than 0.1 voxel on average, where one pass of neighbourhood-averaged offsets stops short)
+//   mildly noisy data there (height-fit residual at most 0.7 final voxels), refit_moved: one
+//   more pass on the bricks whose voxels the last pass moved more than 0.25 voxel on average,
+//   where one pass of neighbourhood-averaged offsets stops short)
 //   stop early when the mean |change| of the snapped voxels is below tolerance. A level's
 //   first pass may run before any level has read the noise; where its reading asks for 4 times
 //   the height fits' points or more, the final level, and a level whose fits read more noise

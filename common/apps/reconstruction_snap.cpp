@@ -134,10 +134,10 @@ constexpr int kPassesAfterCarving = 2;
 // armadillo at 50k points and 0.1 % noise: a second pass over all bricks took its
 // truth-to-surface mean distance 0.198 -> 0.186 voxel, one over the 29 % that moved more than
 // 0.1 voxel 0.188; bench_reconstruct --sweep at 20k points, 0.1 %, on 10 detailed meshes:
-// limits 0.1, 0.15, 0.25 -3.0, -3.0, -2.5 % median, and the least time with 0.25). Only under mild noise (the
-// height fits' residual at most kReferenceNoise final voxels): under strong noise the first
-// pass's large moves are the fits' noise, which a second pass only adds to (20k points, 0.5 %
-// noise: 21 of 33 CGAL meshes worse, median +1.3 %, 19 % more time).
+// limits 0.1, 0.15, 0.25 -3.0, -3.0, -2.5 % median, and the least time with 0.25). Only
+// under mild noise (the height fits' residual at most kReferenceNoise final voxels): under
+// strong noise the first pass's large moves are the fits' noise, which a second pass only
+// adds to (20k points, 0.5 % noise: 21 of 33 CGAL meshes worse, median +1.3 %, 19 % more time).
 constexpr double kRefitChange = 0.25;
 
 // Mean curvature H = div(grad u / |grad u|) by central differences (u a distance, so the
