@@ -6,6 +6,10 @@
 //                          it returns false (then "name: failure" on stderr, unless failure is
 //                          null) or throws levelset::Error ("name: what" on stderr).
 // best_of(runs, f)         the smallest wall-clock time (seconds) of `runs` >= 1 calls of f.
+// best_of_interleaved(runs, f...)
+//                          the same for several functions called in turn (f1, f2, ..., f1, ...),
+//                          so that each side of a ratio sees the same phases of a machine whose
+//                          speed drifts (this project's VMs: 30 % between consecutive runs).
 // RatioSummary             collects a bench's time ratios (ours / OpenVDB's, or ours / another
 //                          reference, lower is better) per kind of row; print() ends the bench
 //                          with one "summary" line per kind: the worst ratio, its row, the
@@ -21,6 +25,7 @@
 #pragma once
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cstdio>
 #include <cstring>
@@ -66,6 +71,24 @@ double best_of(int runs, F&& f) {
     const auto t0 = std::chrono::steady_clock::now();
     f();
     best = std::min(best, std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+  }
+  return best;
+}
+
+template <typename... F>
+std::array<double, sizeof...(F)> best_of_interleaved(int runs, F&&... f) {
+  std::array<double, sizeof...(F)> best;
+  best.fill(1e300);
+  for (int i = 0; i < runs; ++i) {
+    std::size_t k = 0;
+    (
+        [&] {
+          const auto t0 = std::chrono::steady_clock::now();
+          f();
+          best[k] = std::min(best[k], std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+          ++k;
+        }(),
+        ...);
   }
   return best;
 }

@@ -1,7 +1,8 @@
 // bench_surface: our marching cubes and surface nets against OpenVDB's volumeToMesh
 // (isovalue 0, adaptivity 0) on the same band: the CPT band of CGAL's knot.off and
 // bunny00.off at R = 256 and 512 (W = 3), copied into an OpenVDB grid voxel for voxel.
-// Prints times (best of 5: this project's virtual machines vary by 2x within minutes), the
+// Prints times (best of 7 rounds that run the three extractors in turn: this project's virtual
+// machines vary by 2x within minutes, and in turn each side of a ratio sees the same phases), the
 // ratio ours / OpenVDB (target < 1) and triangle counts (OpenVDB's quads count as two
 // triangles), with 1 and 2 threads. Then the cold figure (the daemon re-extracts after every
 // evolution step, and a batch `levelsetd mesh` extracts once):
@@ -33,6 +34,8 @@
 #include "surface/surface_nets.hpp"
 
 namespace {
+
+constexpr int kRuns = 7;
 
 using namespace levelset;
 using levelset::bench::best_of;
@@ -67,15 +70,17 @@ bool bench_mesh(const std::string& path, const std::vector<int>& resolutions, in
     for (int threads : {1, 2}) {
       tbb::global_control limit(tbb::global_control::max_allowed_parallelism, threads);
       std::size_t mc_tris = 0, sn_tris = 0, vdb_tris = 0;
-      const double mc = best_of(runs, [&] { mc_tris = marching_cubes(band).mesh.triangles.size(); });
-      const double sn = best_of(runs, [&] { sn_tris = surface_nets(band).mesh.triangles.size(); });
-      const double vdb = best_of(runs, [&] {
-        std::vector<openvdb::Vec3s> points;
-        std::vector<openvdb::Vec3I> tris;
-        std::vector<openvdb::Vec4I> quads;
-        openvdb::tools::volumeToMesh(*grid, points, tris, quads, 0.0, 0.0);
-        vdb_tris = tris.size() + 2 * quads.size();
-      });
+      // The three extractions in turn, each run's best (bench_support.hpp: the VM's speed drifts).
+      const auto [mc, sn, vdb] = bench::best_of_interleaved(
+          runs, [&] { mc_tris = marching_cubes(band).mesh.triangles.size(); },
+          [&] { sn_tris = surface_nets(band).mesh.triangles.size(); },
+          [&] {
+            std::vector<openvdb::Vec3s> points;
+            std::vector<openvdb::Vec3I> tris;
+            std::vector<openvdb::Vec4I> quads;
+            openvdb::tools::volumeToMesh(*grid, points, tris, quads, 0.0, 0.0);
+            vdb_tris = tris.size() + 2 * quads.size();
+          });
       const std::string name = std::filesystem::path(path).filename().string();
       double cold = 1e300;
       for (int i = 0; i < runs; ++i) cold = std::min(cold, cold_extract(band, threads));
@@ -98,7 +103,7 @@ int main(int argc, char** argv) {
   const bool quick = bench::is_quick(argc, argv);
   openvdb::initialize();
   std::printf("bench_surface: extraction vs OpenVDB %s volumeToMesh (iso 0, adaptivity 0), best of %d\n",
-              openvdb::getLibraryAbiVersionString(), quick ? 1 : 5);
+              openvdb::getLibraryAbiVersionString(), quick ? 1 : kRuns);
   std::printf("%-12s %4s %3s %8s %8s %8s %8s %8s %9s %9s %9s %8s %8s\n", "mesh", "R", "thr", "mc_s", "nets_s",
               "vdb_s", "mc/vdb", "nets/vdb", "mc_tris", "nets_tris", "vdb_tris", "cold_s", "cold/mc");
   bench::RatioSummary summary("bench_surface");
@@ -113,7 +118,7 @@ int main(int argc, char** argv) {
       }
       const bool armadillo = std::string(name) == "armadillo.off";
       ok &= bench_mesh(path, quick ? std::vector<int>{64} : (armadillo ? std::vector<int>{256} : std::vector<int>{256, 512}),
-                       quick ? 1 : 5, summary);
+                       quick ? 1 : kRuns, summary);
       if (quick) break;
     }
     summary.print();
