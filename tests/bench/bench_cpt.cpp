@@ -6,8 +6,9 @@
 //   cheaper: "method"), OpenVDB, the slab scan alone on the coarse rows and the sphere (0 where
 //   not run; one run), the ratio ours / OpenVDB, both bands' active voxels, and our fastest
 //   run's phases (bin / distance / sign / membrane seconds; the sign mesh's orientation runs
-//   beside bin and distance). Times are the best of 3 runs (the dense rows' single runs swung
-//   by 10 % between two runs of the bench on a busy machine).
+//   beside bin and distance). Times are the best of 3 rounds that run ours and OpenVDB's in
+//   turn (the dense rows' single runs swung by 10 % between two runs of the bench on a busy
+//   machine; in turn, both sides of a ratio see the same phases of it).
 // Rows: coarse CGAL meshes (knot, bunny) at R = 256 and 512, W = 3, 6, 12; dense meshes, where
 //   there is about one triangle per surface voxel as in scans and meshes extracted from grids:
 //   a marching-cubes sphere at R = 256 (588k triangles) and every CGAL mesh subdivided until
@@ -61,13 +62,22 @@ bool bench_row(const Row& row, bench::RatioSummary& summary) {
   bool open = false;
   CptTimings phases;  // of the fastest run
   double fastest = 1e300;
-  const double ours = bench::best_of(row.runs, [&] {
-    const CptResult r = closest_point_transform(*row.mesh, options);
-    ours_active = r.band.active_voxel_count();
-    method = r.method;
-    open = r.open_edges > 0;
-    if (r.seconds.total < fastest) fastest = r.seconds.total, phases = r.seconds;
-  });
+  auto xf = openvdb::math::Transform::createLinearTransform(options.frame.voxel_size);
+  // Ours and OpenVDB's in turn, each one's best (bench_support.hpp: the VM's speed drifts).
+  const auto [ours, vdb] = bench::best_of_interleaved(
+      row.runs,
+      [&] {
+        const CptResult r = closest_point_transform(*row.mesh, options);
+        ours_active = r.band.active_voxel_count();
+        method = r.method;
+        open = r.open_edges > 0;
+        if (r.seconds.total < fastest) fastest = r.seconds.total, phases = r.seconds;
+      },
+      [&] {
+        vdb_active = openvdb::tools::meshToLevelSet<openvdb::FloatGrid>(*xf, row.vdb->points, row.vdb->triangles,
+                                                                        float(row.half_width))
+                         ->activeVoxelCount();
+      });
   // The slab scan on the same row (the method before the characteristic scan), where it takes
   // less than a minute: its W^3 work per triangle is what the characteristic scan removes.
   double slab = 0;
@@ -76,12 +86,6 @@ bool bench_row(const Row& row, bench::RatioSummary& summary) {
     by_slab.method = CptMethod::slab_scan;
     slab = bench::best_of(1, [&] { closest_point_transform(*row.mesh, by_slab); });  // a reference column: once
   }
-  auto xf = openvdb::math::Transform::createLinearTransform(options.frame.voxel_size);
-  const double vdb = bench::best_of(row.runs, [&] {
-    vdb_active = openvdb::tools::meshToLevelSet<openvdb::FloatGrid>(*xf, row.vdb->points, row.vdb->triangles,
-                                                                    float(row.half_width))
-                     ->activeVoxelCount();
-  });
   char label[160];
   std::snprintf(label, sizeof label, "%s R=%d W=%g thr=%d", row.name.c_str(), row.resolution, row.half_width,
                 row.threads);
