@@ -621,6 +621,7 @@ SheetFit SheetModel::at(const Vec3d& y) const {
   f.noise_gain = noise_curvature / std::sqrt(1.0 + slope2);
   f.height_residual = height_residual;
   f.has_height = true;
+  f.large_weight = large_weight;
   return f;
 }
 

@@ -167,6 +167,8 @@ struct SheetFit {
   // d height_offset / d sigma^2 of the noise correction (1 / world): the offset for another
   // sigma is height_offset + noise_gain (sigma'^2 - sigma^2), within the correction's bound.
   double noise_gain = 0.0;
+  // SheetModel::large_weight of the model it came from (1 without a height fit).
+  double large_weight = 1.0;
   bool has_height = false;
 };
 SheetFit sheet_fit(const PointIndex& index, const Vec3d& x, const Vec3d& n, int k, int k_height, double min_band,

@@ -97,7 +97,9 @@
 //   first pass found the data clean: the second pass refits along the corrected normals;
 //   mildly noisy data there (height-fit residual at most 0.7 final voxels), refit_moved: one
 //   more pass on the bricks whose voxels the last pass moved more than 0.25 voxel on average,
-//   where one pass of neighbourhood-averaged offsets stops short)
+//   where one pass of neighbourhood-averaged offsets stops short; widen_smooth: a later pass
+//   on a level gives 5/3 the points to the soft-scale height fits of the bricks where the pass
+//   before kept their largest patch with a mean weight of at least 0.4)
 //   stop early when the mean |change| of the snapped voxels is below tolerance. A level's
 //   first pass may run before any level has read the noise; where its reading asks for 4 times
 //   the height fits' points or more, the final level, and a level whose fits read more noise
@@ -158,6 +160,7 @@ struct ReconstructionOptions {
   int snap_passes = 1;          // per finer level (noisy data: more drift, 1 measured best)
   int clean_final_passes = 2;   // final level, clean data (second-order snaps): at least this many
   bool refit_moved = true;      // final level, noisy data: one more pass on the bricks the last one moved far
+  bool widen_smooth = true;     // later passes: wider soft-scale height fits where the pass before kept the largest patch
   double tolerance = 0.01;      // voxels: flow: mean front motion per step; snap: mean change
   bool guard_flow = true;        // coarsest flow: refuse sign changes that change the topology (slower)
   bool guard_snaps = true;      // snaps: the same
@@ -195,6 +198,7 @@ struct ReconstructionStage {
   int webs_cut = 0;                 // of those, webs (cut_webs)
   int web_tunnels = 0;              // finer levels: webs spanning a handle's hole cut, one tunnel each (web_tunnels)
   std::uint64_t refit_bricks = 0;   // final level, noisy data: bricks that took one more snap pass (refit_moved)
+  std::uint64_t widened_bricks = 0;  // bricks whose height fits a later pass widened (widen_smooth), summed over passes
   std::uint64_t carved_voxels = 0;
   std::uint64_t active_voxels = 0;
   std::uint64_t fit_voxels = 0; // local fits computed (cache, or snapped voxels of all passes)
