@@ -1,0 +1,271 @@
+// reconstruct_surface's snap pass (reconstruction_snap_pass.hpp).
+#include "apps/reconstruction_snap_pass.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <vector>
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include "apps/nearby_points.hpp"
+#include "grid/for_each_active_parallel.hpp"
+#include "grid/topology_guard.hpp"
+
+namespace levelset::apps::detail {
+
+namespace {
+
+// Calls f(|dx| + |dy| + |dz|, value index) for every active voxel of the 3x3x3 block around c
+// (c itself included, with 0).
+template <typename F>
+void for_each_active_neighbour27(const NarrowBand& band, BandAccessor& acc, const Coord& c, F&& f) {
+  for (int dz = -1; dz <= 1; ++dz)
+    for (int dy = -1; dy <= 1; ++dy)
+      for (int dx = -1; dx <= 1; ++dx) {
+        const Coord q{c.x + dx, c.y + dy, c.z + dz};
+        const std::uint32_t qb = acc.locate(brick_of(q));
+        if (qb == kNoBrick) continue;
+        const Brick& br = band.bricks()[qb];
+        const int qn = local_index(q);
+        if (!br.active.test(qn)) continue;
+        f(std::abs(dx) + std::abs(dy) + std::abs(dz), br.value_offset + br.slot(qn));
+      }
+}
+
+// Bound on the fits' curvature correction (voxels): a neighbourhood wrapping round a thin
+// part is no local patch. 0.5 measured best on the knot (0.25: bias under k = 24, 1: noise).
+constexpr double kMaxCorrection = 0.5;
+// Snap fits keep the points within max(3 sigma, this many voxels) of the near sheet along the
+// normal (apps/point_distance.hpp one_sided_fit): 2 measured better than 1 on the noisy cases
+// of bench_reconstruct (and the same genus); no trimming gave the bunny's ear a handle.
+constexpr double kOneSidedBand = 2.0;
+// Extra smoothing passes of the snap offsets under noise sigma (voxels): round(gain sigma^2),
+// at most kMaxSmoothing. The heat-equation scale (time sigma^2 / 2, a 3x3x3 box pass ~ h^2 / 3)
+// would give gain 1.5; the fits' noise is spread over their neighbourhoods, so more passes
+// pay: 4 measured best on bench_reconstruct's noisy cases (0.2%: 2-3 passes at the final
+// level), 0 passes on its clean ones.
+constexpr double kSmoothingGain = 4.0;
+// The redone noise correction's change is at most this many of the pass's own noise sigmas
+// (as the fit's own bound, point_distance.cpp).
+constexpr double kMaxNoiseShiftRedo = 0.5;
+
+}  // namespace
+
+// One snap pass (apps/reconstruction.hpp describes it): every voxel with |u| < window h takes the signed offset s
+// of its local fit along the level set's normal, moved by at most one voxel. Per-brick sums
+// added in brick order (deterministic).
+SnapPass snap_to_fits(NarrowBand& band, const PointIndex& index, const SnapSettings& settings, const NarrowBand& coarse,
+                      const std::vector<float>& coarse_curvature, const ProgressHook& progress) {
+  const double h = band.voxel_size();
+  const double window = settings.window, fit_window = std::min(settings.fit_window, settings.window);
+  const int neighbors = settings.neighbors;
+  const bool same_grid = coarse.voxel_size() == h;  // a single level: its own curvature
+  const float unset = std::numeric_limits<float>::quiet_NaN();
+  const FitSettings fit_settings = snap_fit_settings(neighbors, settings.height_neighbors, kOneSidedBand * h, h,
+                                                     {settings.noise, settings.noisy_height, settings.soft_scales},
+                                                     settings.wide_blocks);
+  FitSettings widened_settings = fit_settings;
+  widened_settings.height_neighbors = std::max(settings.height_neighbors, settings.widened_neighbors);
+  // 1. The front offset e = clamp(s - u, +-h) of every voxel within the window.
+  std::vector<float> offset(band.active_voxel_count(), unset);
+  std::vector<std::uint8_t> moves(band.active_voxel_count(), 0);  // within the window
+  std::vector<float> height_offset(band.active_voxel_count(), unset);  // the height fit's, or the plane's
+  std::vector<double> spread(band.brick_count(), 0.0);  // per brick: sum of the fits' spread
+  std::vector<std::uint32_t> fitted(band.brick_count(), 0);
+  std::vector<std::uint32_t> heights(band.brick_count(), 0);
+  std::vector<std::uint32_t> models(band.brick_count(), 0);
+  std::vector<double> residual(band.brick_count(), 0.0);  // per brick: sum of the height fits' residuals
+  std::vector<double> large_weight(band.brick_count(), 0.0);  // per brick: sum of the height fits' large_weight
+  // Noisy data: each height fit's offset from the front before the clamp, and its noise gain
+  // (SheetFit::noise_gain), to redo the noise correction with this pass's own noise below.
+  std::vector<float> raw_second, gain;
+  if (settings.noisy_height) {
+    raw_second.assign(band.active_voxel_count(), unset);
+    gain.assign(band.active_voxel_count(), 0.0f);
+  }
+  tbb::parallel_for(tbb::blocked_range<std::uint32_t>(0, std::uint32_t(band.brick_count()), 8),
+                    [&](const tbb::blocked_range<std::uint32_t>& r) {
+                      progress.check("reconstruct snap");
+                      BandAccessor acc(band), coarse_acc(coarse);
+                      NearbyPoints near(index);
+                      std::vector<FitVoxel> voxels;
+                      std::vector<SheetFit> fits;
+                      for (std::uint32_t b = r.begin(); b != r.end(); ++b) {
+                        if (settings.only && !std::binary_search(settings.only->begin(), settings.only->end(),
+                                                                 brick_key(band.bricks()[b].coord)))
+                          continue;
+                        const bool widened = settings.widen && std::binary_search(settings.widen->begin(), settings.widen->end(),
+                                                                                  brick_key(band.bricks()[b].coord));
+                        const FitSettings& fs = widened ? widened_settings : fit_settings;
+                        prepare_brick_neighbours(band, b, fit_window * h, std::max(neighbors, fs.height_neighbors), near);
+                        std::size_t slot = band.bricks()[b].value_offset;
+                        const Coord origin = brick_origin(band.bricks()[b].coord);
+                        voxels.clear();
+                        band.for_each_active_in_brick(b, [&](const Coord& c, float value) {
+                          const std::size_t i = slot++;
+                          const double u = double(value);
+                          if (!(std::abs(u) < window * h)) return;
+                          moves[i] = 1;
+                          if (!(std::abs(u) < fit_window * h)) return;
+                          const Vec3d g{double(acc.value(c + Coord{1, 0, 0})) - double(acc.value(c - Coord{1, 0, 0})),
+                                        double(acc.value(c + Coord{0, 1, 0})) - double(acc.value(c - Coord{0, 1, 0})),
+                                        double(acc.value(c + Coord{0, 0, 1})) - double(acc.value(c - Coord{0, 0, 1}))};
+                          const double gl = length(g);
+                          if (!(gl > 1e-6)) return;
+                          // The coarse level's curvature: smooth, where the fine one's
+                          // second differences would feed the fits' noise back.
+                          double H = same_grid ? field_at(coarse_acc, coarse, coarse_curvature, c)
+                                               : coarse_field_at(coarse_acc, coarse, coarse_curvature, c);
+                          if (!std::isfinite(H)) H = 0.0;
+                          // The column along the normal's dominant axis: its voxels see the
+                          // same points (fit_voxels).
+                          const Coord l = c - origin;
+                          const int axis = std::abs(g.x) >= std::abs(g.y) && std::abs(g.x) >= std::abs(g.z) ? 0
+                                           : std::abs(g.y) >= std::abs(g.z)                          ? 1
+                                                                                                    : 2;
+                          const int across = axis == 0 ? l.y | l.z << 3 : axis == 1 ? l.x | l.z << 3 : l.x | l.y << 3;
+                          voxels.push_back({i, band.world(c), g / gl, H, u, axis << 6 | across});
+                        });
+                        models[b] = std::uint32_t(fit_voxels(near, voxels, fs, fits));
+                        for (std::size_t v = 0; v < voxels.size(); ++v) {
+                          const FitVoxel& fv = voxels[v];
+                          const SheetFit& sf = fits[v];
+                          const LocalFit& fit = sf.plane;
+                          const double plane = fit.signed_offset(fv.n, fv.H, kMaxCorrection * h);
+                          double second = plane;
+                          if (sf.has_height && std::abs(sf.height_offset - plane) <= settings.height_guard * h) {
+                            second = sf.height_offset;
+                            residual[b] += sf.height_residual;
+                            large_weight[b] += sf.large_weight;
+                            ++heights[b];
+                            if (settings.noisy_height) {
+                              raw_second[fv.i] = float(second - fv.u);
+                              gain[fv.i] = float(sf.noise_gain);
+                            }
+                          }
+                          offset[fv.i] = float(std::clamp(plane - fv.u, -h, h));
+                          height_offset[fv.i] = float(std::clamp(second - fv.u, -h, h));
+                          spread[b] += double(fit.spread);
+                          ++fitted[b];
+                        }
+                      }
+                    });
+  // 2. Each voxel moves by the mean offset of its 3x3x3 neighbourhood: the offset is nearly
+  // constant along normals, so this averages the fits tangentially (their noise / ~3).
+  // Only voxels next to the front may change sign: no new bubbles or handles away from it
+  // (the coarse level fixed the topology).
+  // 2a. Noise: the offsets are smoothed tangentially by `smoothing` more 3x3x3 box passes
+  // (each adds ~2/3 h^2 of variance per axis, a heat-equation time of ~1/3 h^2), their
+  // number set by the mean noise estimate sigma of the fits (kSmoothingGain); none on clean
+  // data, where it would only blur.
+  double sigma_sum = 0.0, residual_sum = 0.0;
+  std::uint64_t sigma_n = 0, height_n = 0;
+  for (std::size_t b = 0; b < spread.size(); ++b) {
+    sigma_sum += spread[b];
+    sigma_n += fitted[b];
+    height_n += heights[b];
+    residual_sum += residual[b];
+  }
+  const double sigma = settings.fixed_sigma >= 0.0 ? settings.fixed_sigma : sigma_n > 0 ? sigma_sum / double(sigma_n) / h : 0.0;
+  // Noisy data: the fits were corrected for the noise the previous pass read; this pass's
+  // height fits, selected for noise, read it better (the previous level, without the
+  // selection, read ~0.85 of it): the correction redone with this pass's mean residual.
+  // bench_reconstruct --sweep, 20k / 0.5 %: 5 cases 1-3 % better (man 1.153 -> 1.124), none
+  // worse; 20k / 0.1 % unchanged.
+  if (settings.noisy_height && height_n > 0) {
+    const double mean = settings.fixed_residual >= 0.0 ? settings.fixed_residual : residual_sum / double(height_n), residual_floor = kResidualFloor * settings.h_final;
+    const double own = std::sqrt(std::max(0.0, mean * mean - residual_floor * residual_floor));
+    const double more = own * own - settings.noise * settings.noise, bound = kMaxNoiseShiftRedo * own;
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, raw_second.size(), 1 << 14),
+                      [&](const tbb::blocked_range<std::size_t>& r) {
+                        for (std::size_t i = r.begin(); i != r.end(); ++i) {
+                          if (std::isnan(raw_second[i])) continue;
+                          const double extra = std::clamp(double(gain[i]) * more, -bound, bound);
+                          height_offset[i] = float(std::clamp(double(raw_second[i]) + extra, -h, h));
+                        }
+                      });
+  }
+  // 2b. Clean data (see kCleanNoise): the height fits' offsets, averaged over face neighbours below.
+  const bool clean = sigma * h < kCleanNoise * settings.h_final;
+  if (clean || settings.noisy_height) offset.swap(height_offset);
+  std::vector<float>().swap(height_offset);
+  const int smoothing = clean                    ? 0
+                        : settings.noisy_height ? int(std::min<long>(1, std::lround(sigma * sigma)))
+                                                : int(std::min<long>(kMaxSmoothing, std::lround(kSmoothingGain * sigma * sigma)));
+  for (int smooth = 0; smooth < smoothing; ++smooth) {
+    std::vector<float> smoothed(offset.size(), unset);
+    for_each_active_parallel(band, band, 8, [&](BandAccessor& acc, std::uint32_t, const Coord& c, float, std::size_t i) {
+      if (!moves[i]) return;
+      double sum = 0.0;
+      int n = 0;
+      for_each_active_neighbour27(band, acc, c, [&](int, std::size_t j) {
+        if (std::isnan(offset[j])) return;
+        sum += double(offset[j]);
+        ++n;
+      });
+      if (n > 0) smoothed[i] = float(sum / n);
+    });
+    offset.swap(smoothed);
+  }
+  std::vector<float> next(band.values().begin(), band.values().end());
+  std::vector<double> change(band.brick_count(), 0.0);
+  std::vector<std::uint32_t> count(band.brick_count(), 0);
+  for_each_active_parallel(band, band, 8, [&](BandAccessor& acc, std::uint32_t b, const Coord& c, float value, std::size_t i) {
+    if (!moves[i]) return;
+    const double u = double(value);
+    const bool inside = u < 0.0;
+    bool at_front = false;
+    double sum = 0.0;
+    int n = 0;
+    for_each_active_neighbour27(band, acc, c, [&](int taxicab, std::size_t j) {
+      if (taxicab == 1 && (band.values()[j] < 0.0f) != inside) at_front = true;
+      if (std::isnan(offset[j])) return;
+      if (clean && taxicab > 1) return;
+      sum += double(offset[j]);
+      ++n;
+    });
+    if (n == 0) return;
+    double target = u + sum / n;
+    if (!at_front && (target < 0.0) != inside) target = inside ? -1e-3 * h : 1e-3 * h;
+    next[i] = float(target);
+    change[b] += std::abs(target - u) / h;
+    ++count[b];
+  });
+  std::uint64_t refused = 0;
+  if (settings.guard) {
+    TopologyGuardOptions guard;
+    guard.eps = 1e-3 * h;
+    guard.progress = progress;
+    TopologyGuardResult kept = guard_topology(band, band, std::move(next), guard);
+    next = std::move(kept.values);
+    refused = kept.refused_flips;
+  }
+  band.swap_values(next);
+  SnapPass pass;
+  pass.refused = refused;
+  pass.noise = sigma;
+  pass.height_noise = height_n > 0 ? residual_sum / double(height_n) / h : 0.0;
+  pass.smoothing = smoothing;
+  pass.clean = clean;
+  pass.height_fits = height_n;
+  for (const std::uint32_t m : models) pass.models += m;
+  for (std::size_t b = 0; b < change.size(); ++b) {
+    pass.mean_change += change[b];
+    pass.voxels += count[b];
+    if (settings.moved_limit > 0.0 && count[b] > 0 && change[b] > settings.moved_limit * double(count[b]))
+      pass.moved.push_back(brick_key(band.bricks()[b].coord));
+  }
+  std::sort(pass.moved.begin(), pass.moved.end());
+  if (settings.soft_scales)
+    for (std::size_t b = 0; b < heights.size(); ++b)
+      if (heights[b] > 0 && large_weight[b] >= kWidenWeight * double(heights[b]))
+        pass.smooth.push_back(brick_key(band.bricks()[b].coord));
+  std::sort(pass.smooth.begin(), pass.smooth.end());
+  if (pass.voxels > 0) pass.mean_change /= double(pass.voxels);
+  return pass;
+}
+
+}  // namespace levelset::apps::detail
