@@ -52,13 +52,25 @@ constexpr double kSmoothingGain = 4.0;
 // (as the fit's own bound, point_distance.cpp).
 constexpr double kMaxNoiseShiftRedo = 0.5;
 
-}  // namespace
+// Step 1 of a pass: the front offset e = clamp(s - u, +-h) of every voxel within the window
+// (the plane fit's, and the height fit's where it passes the guard), with the per-brick sums
+// the pass's readings come from.
+struct FrontOffsets {
+  std::vector<float> offset;         // plane fits (NaN: no fit)
+  std::vector<std::uint8_t> moves;   // within the window
+  std::vector<float> height_offset;  // the height fit's, or the plane's
+  std::vector<double> spread;        // per brick: sum of the fits' spread
+  std::vector<std::uint32_t> fitted, heights, models;  // per brick: fits, usable height fits, models made
+  std::vector<double> residual;      // per brick: sum of the height fits' residuals
+  std::vector<double> large_weight;  // per brick: sum of the height fits' large_weight
+  // Noisy data: each height fit's offset from the front before the clamp, and its noise gain
+  // (SheetFit::noise_gain), to redo the noise correction with the pass's own noise.
+  std::vector<float> raw_second, gain;
+};
 
-// One snap pass (apps/reconstruction.hpp describes it): every voxel with |u| < window h takes the signed offset s
-// of its local fit along the level set's normal, moved by at most one voxel. Per-brick sums
-// added in brick order (deterministic).
-SnapPass snap_to_fits(NarrowBand& band, const PointIndex& index, const SnapSettings& settings, const NarrowBand& coarse,
-                      const std::vector<float>& coarse_curvature, const ProgressHook& progress) {
+FrontOffsets front_offsets(const NarrowBand& band, const PointIndex& index, const SnapSettings& settings,
+                           const NarrowBand& coarse, const std::vector<float>& coarse_curvature,
+                           const ProgressHook& progress) {
   const double h = band.voxel_size();
   const double window = settings.window, fit_window = std::min(settings.fit_window, settings.window);
   const int neighbors = settings.neighbors;
@@ -69,23 +81,17 @@ SnapPass snap_to_fits(NarrowBand& band, const PointIndex& index, const SnapSetti
                                                      settings.wide_blocks);
   FitSettings widened_settings = fit_settings;
   widened_settings.height_neighbors = std::max(settings.height_neighbors, settings.widened_neighbors);
-  // 1. The front offset e = clamp(s - u, +-h) of every voxel within the window.
-  std::vector<float> offset(band.active_voxel_count(), unset);
-  std::vector<std::uint8_t> moves(band.active_voxel_count(), 0);  // within the window
-  std::vector<float> height_offset(band.active_voxel_count(), unset);  // the height fit's, or the plane's
-  std::vector<double> spread(band.brick_count(), 0.0);  // per brick: sum of the fits' spread
-  std::vector<std::uint32_t> fitted(band.brick_count(), 0);
-  std::vector<std::uint32_t> heights(band.brick_count(), 0);
-  std::vector<std::uint32_t> models(band.brick_count(), 0);
-  std::vector<double> residual(band.brick_count(), 0.0);  // per brick: sum of the height fits' residuals
-  std::vector<double> large_weight(band.brick_count(), 0.0);  // per brick: sum of the height fits' large_weight
-  // Noisy data: each height fit's offset from the front before the clamp, and its noise gain
-  // (SheetFit::noise_gain), to redo the noise correction with this pass's own noise below.
-  std::vector<float> raw_second, gain;
+  FrontOffsets out;
+  out.offset.assign(band.active_voxel_count(), unset);
+  out.moves.assign(band.active_voxel_count(), 0);
+  out.height_offset.assign(band.active_voxel_count(), unset);
+  for (auto* v : {&out.spread, &out.residual, &out.large_weight}) v->assign(band.brick_count(), 0.0);
+  for (auto* v : {&out.fitted, &out.heights, &out.models}) v->assign(band.brick_count(), 0);
   if (settings.noisy_height) {
-    raw_second.assign(band.active_voxel_count(), unset);
-    gain.assign(band.active_voxel_count(), 0.0f);
+    out.raw_second.assign(band.active_voxel_count(), unset);
+    out.gain.assign(band.active_voxel_count(), 0.0f);
   }
+  auto& [offset, moves, height_offset, spread, fitted, heights, models, residual, large_weight, raw_second, gain] = out;
   tbb::parallel_for(tbb::blocked_range<std::uint32_t>(0, std::uint32_t(band.brick_count()), 8),
                     [&](const tbb::blocked_range<std::uint32_t>& r) {
                       progress.check("reconstruct snap");
@@ -153,6 +159,79 @@ SnapPass snap_to_fits(NarrowBand& band, const PointIndex& index, const SnapSetti
                         }
                       }
                     });
+  return out;
+}
+
+// One 3x3x3 box pass over the offsets of the voxels that move (NaN: no offset, skipped).
+std::vector<float> box_smoothed(const NarrowBand& band, const std::vector<float>& offset,
+                                const std::vector<std::uint8_t>& moves) {
+  std::vector<float> smoothed(offset.size(), std::numeric_limits<float>::quiet_NaN());
+  for_each_active_parallel(band, band, 8, [&](BandAccessor& acc, std::uint32_t, const Coord& c, float, std::size_t i) {
+    if (!moves[i]) return;
+    double sum = 0.0;
+    int n = 0;
+    for_each_active_neighbour27(band, acc, c, [&](int, std::size_t j) {
+      if (std::isnan(offset[j])) return;
+      sum += double(offset[j]);
+      ++n;
+    });
+    if (n > 0) smoothed[i] = float(sum / n);
+  });
+  return smoothed;
+}
+
+// Step 2's move: every voxel that moves takes the mean offset of its 3x3x3 neighbourhood (the
+// voxel and its 6 face neighbours only on clean data); only voxels next to the front may
+// change sign. values: the band's new values; change, count: per brick, the sum of |change|
+// (voxels) and the voxels moved.
+struct MovedFront {
+  std::vector<float> values;
+  std::vector<double> change;
+  std::vector<std::uint32_t> count;
+};
+
+MovedFront moved_front(const NarrowBand& band, const std::vector<float>& offset, const std::vector<std::uint8_t>& moves,
+                       bool clean) {
+  const double h = band.voxel_size();
+  MovedFront out{std::vector<float>(band.values().begin(), band.values().end()),
+                 std::vector<double>(band.brick_count(), 0.0), std::vector<std::uint32_t>(band.brick_count(), 0)};
+  std::vector<float>& next = out.values;
+  std::vector<double>& change = out.change;
+  std::vector<std::uint32_t>& count = out.count;
+  for_each_active_parallel(band, band, 8, [&](BandAccessor& acc, std::uint32_t b, const Coord& c, float value, std::size_t i) {
+    if (!moves[i]) return;
+    const double u = double(value);
+    const bool inside = u < 0.0;
+    bool at_front = false;
+    double sum = 0.0;
+    int n = 0;
+    for_each_active_neighbour27(band, acc, c, [&](int taxicab, std::size_t j) {
+      if (taxicab == 1 && (band.values()[j] < 0.0f) != inside) at_front = true;
+      if (std::isnan(offset[j])) return;
+      if (clean && taxicab > 1) return;
+      sum += double(offset[j]);
+      ++n;
+    });
+    if (n == 0) return;
+    double target = u + sum / n;
+    if (!at_front && (target < 0.0) != inside) target = inside ? -1e-3 * h : 1e-3 * h;
+    next[i] = float(target);
+    change[b] += std::abs(target - u) / h;
+    ++count[b];
+  });
+  return out;
+}
+
+}  // namespace
+
+// One snap pass (apps/reconstruction.hpp describes it): every voxel with |u| < window h takes
+// the signed offset s of its local fit along the level set's normal, moved by at most one
+// voxel. Per-brick sums added in brick order (deterministic).
+SnapPass snap_to_fits(NarrowBand& band, const PointIndex& index, const SnapSettings& settings, const NarrowBand& coarse,
+                      const std::vector<float>& coarse_curvature, const ProgressHook& progress) {
+  const double h = band.voxel_size();
+  FrontOffsets fronts = front_offsets(band, index, settings, coarse, coarse_curvature, progress);
+  auto& [offset, moves, height_offset, spread, fitted, heights, models, residual, large_weight, raw_second, gain] = fronts;
   // 2. Each voxel moves by the mean offset of its 3x3x3 neighbourhood: the offset is nearly
   // constant along normals, so this averages the fits tangentially (their noise / ~3).
   // Only voxels next to the front may change sign: no new bubbles or handles away from it
@@ -195,45 +274,11 @@ SnapPass snap_to_fits(NarrowBand& band, const PointIndex& index, const SnapSetti
   const int smoothing = clean                    ? 0
                         : settings.noisy_height ? int(std::min<long>(1, std::lround(sigma * sigma)))
                                                 : int(std::min<long>(kMaxSmoothing, std::lround(kSmoothingGain * sigma * sigma)));
-  for (int smooth = 0; smooth < smoothing; ++smooth) {
-    std::vector<float> smoothed(offset.size(), unset);
-    for_each_active_parallel(band, band, 8, [&](BandAccessor& acc, std::uint32_t, const Coord& c, float, std::size_t i) {
-      if (!moves[i]) return;
-      double sum = 0.0;
-      int n = 0;
-      for_each_active_neighbour27(band, acc, c, [&](int, std::size_t j) {
-        if (std::isnan(offset[j])) return;
-        sum += double(offset[j]);
-        ++n;
-      });
-      if (n > 0) smoothed[i] = float(sum / n);
-    });
-    offset.swap(smoothed);
-  }
-  std::vector<float> next(band.values().begin(), band.values().end());
-  std::vector<double> change(band.brick_count(), 0.0);
-  std::vector<std::uint32_t> count(band.brick_count(), 0);
-  for_each_active_parallel(band, band, 8, [&](BandAccessor& acc, std::uint32_t b, const Coord& c, float value, std::size_t i) {
-    if (!moves[i]) return;
-    const double u = double(value);
-    const bool inside = u < 0.0;
-    bool at_front = false;
-    double sum = 0.0;
-    int n = 0;
-    for_each_active_neighbour27(band, acc, c, [&](int taxicab, std::size_t j) {
-      if (taxicab == 1 && (band.values()[j] < 0.0f) != inside) at_front = true;
-      if (std::isnan(offset[j])) return;
-      if (clean && taxicab > 1) return;
-      sum += double(offset[j]);
-      ++n;
-    });
-    if (n == 0) return;
-    double target = u + sum / n;
-    if (!at_front && (target < 0.0) != inside) target = inside ? -1e-3 * h : 1e-3 * h;
-    next[i] = float(target);
-    change[b] += std::abs(target - u) / h;
-    ++count[b];
-  });
+  for (int smooth = 0; smooth < smoothing; ++smooth) offset = box_smoothed(band, offset, moves);
+  MovedFront moved = moved_front(band, offset, moves, clean);
+  std::vector<float>& next = moved.values;
+  const std::vector<double>& change = moved.change;
+  const std::vector<std::uint32_t>& count = moved.count;
   std::uint64_t refused = 0;
   if (settings.guard) {
     TopologyGuardOptions guard;

@@ -101,9 +101,9 @@ struct SnapSettings {
   int widened_neighbors = 0;
 };
 
-// One snap pass (apps/reconstruction.hpp describes it): every voxel with |u| < window h takes the signed offset s
-// of its local fit along the level set's normal, moved by at most one voxel. Per-brick sums
-// added in brick order (deterministic).
+// One snap pass (apps/reconstruction.hpp describes it): every voxel with |u| < window h takes
+// the signed offset s of its local fit along the level set's normal, moved by at most one
+// voxel. Per-brick sums added in brick order (deterministic).
 SnapPass snap_to_fits(NarrowBand& band, const PointIndex& index, const SnapSettings& settings, const NarrowBand& coarse,
                       const std::vector<float>& coarse_curvature, const ProgressHook& progress);
 
