@@ -4,6 +4,8 @@
 //                             fitted points, one guarded step at a time, strays dropped;
 //   reconstruction_snap.cpp   every finer level (and a single one): the snap of the front onto
 //                             the local fits, pass after pass;
+//   reconstruction_snap_pass.cpp  one snap pass (its settings and readings:
+//                             reconstruction_snap_pass.hpp);
 //   reconstruction_fits.cpp   a snap pass's local fits of one brick's voxels, shared along
 //                             columns and blocks of voxels that see the same points;
 //   reconstruction_carve.cpp  gaps the start shell closed reopened where the points sampling
