@@ -1,23 +1,14 @@
 // reconstruct_surface's finer levels: the snap of the front onto the points' local fits
 // (reconstruction_parts.hpp).
 #include <algorithm>
-#include <array>
-#include <atomic>
 #include <cmath>
 #include <cstdint>
-#include <limits>
-#include <string>
 #include <vector>
 
-#include <tbb/blocked_range.h>
-#include <tbb/parallel_for.h>
-
-#include "apps/nearby_points.hpp"
 #include "apps/reconstruction_parts.hpp"
 #include "apps/reconstruction_snap_pass.hpp"
 #include "distance/redistance.hpp"
 #include "grid/for_each_active_parallel.hpp"
-#include "grid/topology_guard.hpp"
 
 namespace levelset::apps::detail {
 
