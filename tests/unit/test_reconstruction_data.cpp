@@ -449,6 +449,14 @@ double chamfer_ratio(const OnAndOff& r, const TriangleMesh& truth, const char* b
   return with / without;
 }
 
+// The bricks a step touched (`field` of the final stage): some with it on, none with it off.
+std::uint64_t step_bricks(const OnAndOff& r, std::uint64_t ReconstructionStage::*field) {
+  const std::uint64_t on = r.on.stages.back().*field;
+  EXPECT_GT(on, 0u);
+  EXPECT_EQ(r.off.stages.back().*field, 0u);
+  return on;
+}
+
 TEST(Reconstruction, NoisyDetailTakesOneMorePassWhereTheFrontMovedFar) {
   // CGAL's cow (legs, ears, horns a few voxels across) from 20k points, noise 0.1 % of the
   // diagonal (about half a final voxel: the noisy snap route), resolution 256. One snap pass
@@ -458,12 +466,10 @@ TEST(Reconstruction, NoisyDetailTakesOneMorePassWhereTheFrontMovedFar) {
   // points: 0.654 -> 0.616 of Poisson's).
   const CgalCase cow = cgal_case("cow.off", 20000);
   const OnAndOff r = with_and_without(cow.points, [](ReconstructionOptions& o) { o.refit_moved = false; });
-  const ReconstructionStage& on = r.on.stages.back();
-  EXPECT_FALSE(on.second_order);
-  EXPECT_GT(on.refit_bricks, 0u);
-  EXPECT_LT(double(on.refit_bricks), 0.3 * double(r.on.band.brick_count()));
-  EXPECT_EQ(r.off.stages.back().refit_bricks, 0u);
-  EXPECT_LT(chamfer_ratio(r, cow.truth, "refit", on.refit_bricks), 0.97);
+  EXPECT_FALSE(r.on.stages.back().second_order);
+  const std::uint64_t refit = step_bricks(r, &ReconstructionStage::refit_bricks);
+  EXPECT_LT(double(refit), 0.3 * double(r.on.band.brick_count()));
+  EXPECT_LT(chamfer_ratio(r, cow.truth, "refit", refit), 0.97);
   EXPECT_EQ(r.on.measures.genus, 0.0);
 }
 
@@ -476,11 +482,9 @@ TEST(Reconstruction, SmoothPartsTakeWiderFitsOnTheSecondPass) {
   // 0.726 of Poisson's).
   const CgalCase ellipsoid = cgal_case("ellipe0.003.off", 20000);
   const OnAndOff r = with_and_without(ellipsoid.points, [](ReconstructionOptions& o) { o.widen_smooth = false; });
-  const ReconstructionStage& on = r.on.stages.back();
-  EXPECT_TRUE(on.second_order);
-  EXPECT_GT(on.widened_bricks, 0u);
-  EXPECT_EQ(r.off.stages.back().widened_bricks, 0u);
-  EXPECT_LT(chamfer_ratio(r, ellipsoid.truth, "widened", on.widened_bricks), 0.96);
+  EXPECT_TRUE(r.on.stages.back().second_order);
+  const std::uint64_t widened = step_bricks(r, &ReconstructionStage::widened_bricks);
+  EXPECT_LT(chamfer_ratio(r, ellipsoid.truth, "widened", widened), 0.96);
   EXPECT_EQ(r.on.measures.genus, 0.0);
 }
 
