@@ -243,6 +243,7 @@ struct Sheet {
   double ref = 0.0;   // the near sheet's t
   double band = 0.0;  // kept: |t - ref| <= band
   double sigma = 0.0;
+  int facing_away = 0;  // of the nearest points, left out as facing away (sheet_fit)
 };
 
 double median_of(std::array<double, 8> v, int size) {
@@ -251,12 +252,31 @@ double median_of(std::array<double, 8> v, int size) {
   return size % 2 == 1 ? v[std::size_t(size / 2)] : 0.5 * (v[std::size_t(size / 2 - 1)] + v[std::size_t(size / 2)]);
 }
 
+// Drops the points facing away from n (see sheet_fit) from the first `count` of idx and d2,
+// keeping their order; returns how many are left (all `count` when none would be).
+int drop_facing_away(std::span<const Vec3f> facing, const Vec3d& n, int count, Sheet& s) {
+  int kept = 0;
+  for (int i = 0; i < count; ++i) {
+    const Vec3f& f = facing[s.idx[std::size_t(i)]];
+    if (double(f.x) * n.x + double(f.y) * n.y + double(f.z) * n.z < 0.0) continue;
+    s.idx[std::size_t(kept)] = s.idx[std::size_t(i)];
+    s.d2[std::size_t(kept++)] = s.d2[std::size_t(i)];
+  }
+  return kept > 0 ? kept : count;
+}
+
 // near: the same k nearest points from a prepared neighbourhood, or null (the tree).
+// facing: empty, or one entry per point of the index (sheet_fit).
 void find_sheet(const PointIndex& index, const NearbyPoints* nearby, const Vec3d& x, const Vec3d& n, int k,
-                double min_band, Sheet& s) {
+                double min_band, std::span<const Vec3f> facing, Sheet& s) {
   k = std::clamp(k, 1, kMaxNeighbors);
   s.count = nearby ? nearby->k_nearest(x, k, s.idx.data(), s.d2.data()) : index.k_nearest(x, k, s.idx.data(), s.d2.data());
   if (s.count == 0) return;
+  if (!facing.empty()) {
+    const int all = s.count;
+    s.count = drop_facing_away(facing, n, all, s);
+    s.facing_away = all - s.count;
+  }
   for (int i = 0; i < s.count; ++i) s.t[std::size_t(i)] = dot(x - index.points()[s.idx[std::size_t(i)]], n);
   const int m = std::min(s.count, 8);
   std::array<double, 8> near{};
@@ -318,7 +338,7 @@ bool solve_spd(std::array<double, N * N>& M, std::array<double, N>& r, double re
 
 LocalFit one_sided_fit(const PointIndex& index, const Vec3d& x, const Vec3d& n, int k, double min_band) {
   Sheet sh;
-  find_sheet(index, nullptr, x, n, k, min_band, sh);
+  find_sheet(index, nullptr, x, n, k, min_band, {}, sh);
   return sheet_moments(index, x, sh, sh.count);
 }
 
@@ -547,13 +567,14 @@ void correct_for_noise(HeightFit& f, double kappa, double sigma, double factor) 
 }
 
 SheetModel sheet_model_from(const PointIndex& index, const NearbyPoints* near, const Vec3d& x, const Vec3d& n, int k,
-                            int k_height, double min_band, const HeightNoise& noise) {
+                            int k_height, double min_band, const HeightNoise& noise, std::span<const Vec3f> facing) {
   Sheet sh;
-  find_sheet(index, near, x, n, std::max(k, k_height), min_band, sh);
+  find_sheet(index, near, x, n, std::max(k, k_height), min_band, facing, sh);
   SheetModel f;
   f.x = x;
   f.n = n;
   f.plane = sheet_moments(index, x, sh, k);
+  f.facing_away = sh.facing_away;
   // Height function z(xi, eta) over the tangent plane of n at x.
   const Vec3d t1 = std::abs(n.x) < 0.6 ? cross(n, Vec3d{1, 0, 0}) : cross(n, Vec3d{0, 1, 0});
   const Vec3d e1 = t1 / length(t1);
@@ -596,6 +617,7 @@ SheetModel sheet_model_from(const PointIndex& index, const NearbyPoints* near, c
 SheetFit SheetModel::at(const Vec3d& y) const {
   SheetFit f;
   f.plane = plane;
+  f.facing_away = facing_away;
   const Vec3d d = y - x;
   if (d.x != 0.0 || d.y != 0.0 || d.z != 0.0) {
     // Moments about y: mean(y - p) = a + d; mean (y - p)(y - p)^T = S + d a^T + a d^T + d d^T.
@@ -627,22 +649,23 @@ SheetFit SheetModel::at(const Vec3d& y) const {
 
 SheetFit sheet_fit(const PointIndex& index, const Vec3d& x, const Vec3d& n, int k, int k_height, double min_band,
                    HeightNoise noise) {
-  return sheet_model_from(index, nullptr, x, n, k, k_height, min_band, noise).at(x);
+  return sheet_model_from(index, nullptr, x, n, k, k_height, min_band, noise, {}).at(x);
 }
 
 SheetFit sheet_fit(const NearbyPoints& near, const Vec3d& x, const Vec3d& n, int k, int k_height, double min_band,
-                   HeightNoise noise) {
-  return sheet_model_from(near.index(), &near, x, n, k, k_height, min_band, noise).at(x);
+                   HeightNoise noise, std::span<const Vec3f> facing) {
+  return sheet_model_from(near.index(), &near, x, n, k, k_height, min_band, noise, facing).at(x);
 }
 
 SheetModel sheet_model(const NearbyPoints& near, const Vec3d& x, const Vec3d& n, int k, int k_height,
-                       double min_band, HeightNoise noise) {
-  return sheet_model_from(near.index(), &near, x, n, k, k_height, min_band, noise);
+                       double min_band, HeightNoise noise, std::span<const Vec3f> facing) {
+  return sheet_model_from(near.index(), &near, x, n, k, k_height, min_band, noise, facing);
 }
 
-LocalFit sheet_plane(const NearbyPoints& near, const Vec3d& x, const Vec3d& n, int k, double min_band) {
+LocalFit sheet_plane(const NearbyPoints& near, const Vec3d& x, const Vec3d& n, int k, double min_band,
+                     std::span<const Vec3f> facing) {
   Sheet sh;
-  find_sheet(near.index(), &near, x, n, k, min_band, sh);
+  find_sheet(near.index(), &near, x, n, k, min_band, facing, sh);
   return sheet_moments(near.index(), x, sh, k);
 }
 

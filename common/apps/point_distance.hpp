@@ -169,14 +169,21 @@ struct SheetFit {
   double noise_gain = 0.0;
   // SheetModel::large_weight of the model it came from (1 without a height fit).
   double large_weight = 1.0;
+  int facing_away = 0;  // of the nearest points, left out as facing away (facing)
   bool has_height = false;
 };
 SheetFit sheet_fit(const PointIndex& index, const Vec3d& x, const Vec3d& n, int k, int k_height, double min_band,
                    HeightNoise noise = {});
 // The same, its k nearest points from a neighbourhood prepared around x (apps/nearby_points.hpp).
+// facing (optional, one entry per point of the index, or empty): which way each point's side
+// of a surface estimate faces, a unit vector (zero: not known). Of the k nearest points, those
+// facing away from n (facing . n < 0) are left out before the sheet is sought, unless that
+// leaves none: the far side of a part thinner than the neighbourhood and the other wall of a
+// narrow gap, whose points the band about the near sheet takes in under noise of a third of
+// the part's thickness or more (the fit then sinks toward the part's middle).
 class NearbyPoints;
 SheetFit sheet_fit(const NearbyPoints& near, const Vec3d& x, const Vec3d& n, int k, int k_height, double min_band,
-                   HeightNoise noise = {});
+                   HeightNoise noise = {}, std::span<const Vec3f> facing = {});
 
 // A sheet fit made once at x and evaluated at positions y near it (the voxels of a small block
 // can share one fit). at(y): the plane fit's moments moved to y (a and S are moments about the
@@ -197,13 +204,17 @@ struct SheetModel {
   // choice kept it, 0 where it took a smaller patch's, between where the soft choice blended
   // (a patch bent by detail reads below 1).
   double large_weight = 1.0;
+  int facing_away = 0;  // of the nearest points, left out as facing away (sheet_fit's facing)
   double patch_radius() const { return inv_r > 0.0 ? 1.0 / inv_r : 0.0; }
   SheetFit at(const Vec3d& y) const;
 };
 SheetModel sheet_model(const NearbyPoints& near, const Vec3d& x, const Vec3d& n, int k, int k_height, double min_band,
-                       HeightNoise noise = {});
-// sheet_fit's plane part alone (its k nearest points only): bit for bit sheet_fit(...).plane.
-LocalFit sheet_plane(const NearbyPoints& near, const Vec3d& x, const Vec3d& n, int k, double min_band);
+                       HeightNoise noise = {}, std::span<const Vec3f> facing = {});
+// sheet_fit's plane part alone (its k nearest points only): bit for bit sheet_fit(...).plane
+// without facing (with it, of the k nearest only those facing n, where sheet_fit's plane takes
+// the first k facing n of its max(k, k_height) nearest).
+LocalFit sheet_plane(const NearbyPoints& near, const Vec3d& x, const Vec3d& n, int k, double min_band,
+                     std::span<const Vec3f> facing = {});
 
 struct PointFitFieldOptions {
   int neighbors = 8;  // k

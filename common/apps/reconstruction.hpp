@@ -161,6 +161,7 @@ struct ReconstructionOptions {
   int clean_final_passes = 2;   // final level, clean data (second-order snaps): at least this many
   bool refit_moved = true;      // final level, noisy data: one more pass on the bricks the last one moved far
   bool widen_smooth = true;     // later passes: wider soft-scale height fits where the pass before kept the largest patch
+  bool facing_points = true;    // snaps: fits leave out the points facing away from the front (a thin part's far side)
   double tolerance = 0.01;      // voxels: flow: mean front motion per step; snap: mean change
   bool guard_flow = true;        // coarsest flow: refuse sign changes that change the topology (slower)
   bool guard_snaps = true;      // snaps: the same
@@ -203,6 +204,7 @@ struct ReconstructionStage {
   std::uint64_t active_voxels = 0;
   std::uint64_t fit_voxels = 0; // local fits computed (cache, or snapped voxels of all passes)
   std::uint64_t fit_models = 0; // snap: sheet fits made for them (voxels of a column or block share one)
+  std::uint64_t facing_fits = 0;  // snap: fits that left out points facing away (facing_points), all passes
   double seconds = 0.0;         // whole level
   double seconds_start = 0.0;   // start shell, or upsampling
   double seconds_fit = 0.0;     // fits (the snap passes' fits and updates)

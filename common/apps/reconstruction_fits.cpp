@@ -6,8 +6,12 @@
 #include <optional>
 #include <vector>
 
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
 #include "apps/nearby_points.hpp"
 #include "apps/reconstruction_parts.hpp"
+#include "grid/interpolate.hpp"
 
 namespace levelset::apps::detail {
 
@@ -73,7 +77,7 @@ struct GroupFits {
   void own(const int* group, int count) {
     for (int j = 0; j < count; ++j) {
       const FitVoxel& v = voxels[std::size_t(group[j])];
-      fits[std::size_t(group[j])] = sheet_fit(near, v.x, v.n, fs.neighbors, fs.height_neighbors, fs.min_band, fs.noise);
+      fits[std::size_t(group[j])] = sheet_fit(near, v.x, v.n, fs.neighbors, fs.height_neighbors, fs.min_band, fs.noise, fs.facing);
       ++models;
     }
   }
@@ -91,7 +95,7 @@ struct GroupFits {
     }
     ++models;
     return sheet_model(near, centroid / double(count), normal / nl, fs.neighbors, fs.height_neighbors, fs.min_band,
-                       fs.noise);
+                       fs.noise, fs.facing);
   }
   void evaluate(const SheetModel& model, const int* group, int count) {
     for (int j = 0; j < count; ++j) fits[std::size_t(group[j])] = model.at(voxels[std::size_t(group[j])].x);
@@ -103,7 +107,7 @@ struct GroupFits {
       const FitVoxel& v = voxels[std::size_t(group[j])];
       SheetFit& f = fits[std::size_t(group[j])];
       f = model.at(v.x);
-      f.plane = sheet_plane(near, v.x, v.n, fs.neighbors, fs.min_band);
+      f.plane = sheet_plane(near, v.x, v.n, fs.neighbors, fs.min_band, fs.facing);
     }
   }
   // The voxels of a group split by key(v), each part (stably sorted) passed to f.
@@ -143,7 +147,26 @@ struct GroupFits {
 
 FitSettings snap_fit_settings(int neighbors, int height_neighbors, double min_band, double h, HeightNoise noise,
                               bool wide_blocks) {
-  return {neighbors, height_neighbors, min_band, kShareRadius * h, kBlockRadius * h, wide_blocks, noise};
+  return {neighbors, height_neighbors, min_band, kShareRadius * h, kBlockRadius * h, wide_blocks, noise, {}};
+}
+
+std::vector<Vec3f> point_facing(const NarrowBand& band, const PointIndex& index, double max_depth) {
+  const double h = band.voxel_size();
+  std::vector<Vec3f> facing(index.size());
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, index.size(), 4096), [&](const tbb::blocked_range<std::size_t>& r) {
+    BandAccessor acc(band);
+    auto difference = [&](const Vec3d& p, const Vec3d& step) {
+      return double(sample_trilinear(acc, band, p + step)) - double(sample_trilinear(acc, band, p - step));
+    };
+    for (std::size_t i = r.begin(); i != r.end(); ++i) {
+      const Vec3d& p = index.points()[i];
+      if (!(std::abs(double(sample_trilinear(acc, band, p))) <= max_depth)) continue;
+      const Vec3d g{difference(p, {h, 0, 0}), difference(p, {0, h, 0}), difference(p, {0, 0, h})};
+      const double gl = length(g);
+      facing[i] = gl > 1e-6 * h ? Vec3f{float(g.x / gl), float(g.y / gl), float(g.z / gl)} : Vec3f{};
+    }
+  });
+  return facing;
 }
 
 // One radius query around the box of the brick's fit voxels (bunny, 20k points, 0.1 %: the

@@ -20,6 +20,7 @@
 
 #include <chrono>
 #include <cstdint>
+#include <span>
 #include <vector>
 
 #include "apps/point_distance.hpp"
@@ -72,6 +73,7 @@ struct FitSettings {
   double block_radius;  // world: 2x2 blocks of columns share one where it is at least this wide (0: never)
   bool wide_blocks;     // the blocks are 4x4 columns (strong noise), each split into 2x2 where needed
   HeightNoise noise;    // the points' noise, which the height fits correct for (sheet_fit)
+  std::span<const Vec3f> facing;  // per point, or empty: fits leave out the points facing away (sheet_fit)
 };
 
 // The pass's fit settings at voxel size h (world): neighbors / height_neighbors points, the
@@ -79,6 +81,14 @@ struct FitSettings {
 // constants in the .cpp.
 FitSettings snap_fit_settings(int neighbors, int height_neighbors, double min_band, double h, HeightNoise noise,
                               bool wide_blocks);
+// Which way each point faces (sheet_fit's facing): the unit gradient of the band's level set at
+// the point (central differences of trilinear samples a voxel apart), zero where it has none
+// (beyond the band, all samples at its limit) or where the point lies farther than max_depth
+// (world) from the front. A point of a thin part's far side, or of a narrow gap's other wall,
+// lies nearer to that side of the front than to the near one, so it faces away from the near
+// side's normal; a point far from the front (the wall of a hole the front spans) says nothing
+// about the side it samples. Cost: 7 trilinear samples per point; TBB.
+std::vector<Vec3f> point_facing(const NarrowBand& band, const PointIndex& index, double max_depth);
 // The k nearest points of every voxel of brick b with |u| < window (world) from one radius
 // query (apps/nearby_points.hpp; identical results): around the box of those voxels; the
 // tree answers where the brick has fewer than a few such voxels.

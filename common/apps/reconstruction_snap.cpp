@@ -168,6 +168,7 @@ SnapSettings snap_settings(const ReconstructionOptions& o, const NarrowBand& ban
   settings.fit_window = refine ? kRefineWindow : kFitWindow;
   settings.h_final = h_final;
   settings.guard = o.guard_snaps;
+  settings.facing_points = o.facing_points;
   return settings;
 }
 
@@ -215,6 +216,7 @@ SnapOutput snap_level(NarrowBand band, const PointIndex& index, const Reconstruc
     stage.refused_flips += snapped.refused;
     stage.fit_voxels += snapped.voxels;
     stage.fit_models += snapped.models;
+    stage.facing_fits += snapped.facing_fits;
     stage.seconds_fit += seconds_since(t_fit);
     const auto t_redistance = Clock::now();
     band = redistanced(band, W, 1.0, o.progress);
@@ -275,6 +277,7 @@ SnapOutput snap_level(NarrowBand band, const PointIndex& index, const Reconstruc
     stage.seconds_fit += seconds_since(t_fit);
     stage.fit_voxels += snapped.voxels;
     stage.fit_models += snapped.models;
+    stage.facing_fits += snapped.facing_fits;
     stage.last_change = snapped.mean_change;
     stage.noise = snapped.noise;
     stage.height_noise = snapped.height_noise;

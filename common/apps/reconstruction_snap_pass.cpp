@@ -48,6 +48,15 @@ constexpr double kOneSidedBand = 2.0;
 // pay: 4 measured best on bench_reconstruct's noisy cases (0.2%: 2-3 passes at the final
 // level), 0 passes on its clean ones.
 constexpr double kSmoothingGain = 4.0;
+// The fits leave out the points facing away from the front (point_facing) among those within
+// max(kFacingDepth voxels, kFacingNoiseDepth sigma) of it: a thin part's far side lies within
+// its noise of the front's far side. Deeper points keep no facing, so every fit takes them: the
+// walls of a hole that the front spans (CGAL's turbine, 50k clean points: with no depth bound
+// the plugs' fits left out the walls' points and stayed on the plate's faces, and the web
+// tunnels opened 2 of the bolt holes, genus 3; with this bound genus 5, as without facing).
+// 0.5 and 1 voxel were tried there (1: genus 3).
+constexpr double kFacingDepth = 0.5;
+constexpr double kFacingNoiseDepth = 3.0;
 // The redone noise correction's change is at most this many of the pass's own noise sigmas
 // (as the fit's own bound, point_distance.cpp).
 constexpr double kMaxNoiseShiftRedo = 0.5;
@@ -63,6 +72,7 @@ struct FrontOffsets {
   std::vector<std::uint32_t> fitted, heights, models;  // per brick: fits, usable height fits, models made
   std::vector<double> residual;      // per brick: sum of the height fits' residuals
   std::vector<double> large_weight;  // per brick: sum of the height fits' large_weight
+  std::vector<std::uint32_t> facing_fits;  // per brick: fits that left out points facing away
   // Noisy data: each height fit's offset from the front before the clamp, and its noise gain
   // (SheetFit::noise_gain), to redo the noise correction with the pass's own noise.
   std::vector<float> raw_second, gain;
@@ -76,9 +86,14 @@ FrontOffsets front_offsets(const NarrowBand& band, const PointIndex& index, cons
   const int neighbors = settings.neighbors;
   const bool same_grid = coarse.voxel_size() == h;  // a single level: its own curvature
   const float unset = std::numeric_limits<float>::quiet_NaN();
-  const FitSettings fit_settings = snap_fit_settings(neighbors, settings.height_neighbors, kOneSidedBand * h, h,
+  FitSettings fit_settings = snap_fit_settings(neighbors, settings.height_neighbors, kOneSidedBand * h, h,
                                                      {settings.noise, settings.noisy_height, settings.soft_scales},
                                                      settings.wide_blocks);
+  // Which way the points face, from the band before the pass (reconstruction_parts.hpp).
+  const std::vector<Vec3f> facing = settings.facing_points
+                                        ? point_facing(band, index, std::max(kFacingDepth * h, kFacingNoiseDepth * settings.noise))
+                                        : std::vector<Vec3f>{};
+  fit_settings.facing = facing;
   FitSettings widened_settings = fit_settings;
   widened_settings.height_neighbors = std::max(settings.height_neighbors, settings.widened_neighbors);
   FrontOffsets out;
@@ -86,12 +101,13 @@ FrontOffsets front_offsets(const NarrowBand& band, const PointIndex& index, cons
   out.moves.assign(band.active_voxel_count(), 0);
   out.height_offset.assign(band.active_voxel_count(), unset);
   for (auto* v : {&out.spread, &out.residual, &out.large_weight}) v->assign(band.brick_count(), 0.0);
-  for (auto* v : {&out.fitted, &out.heights, &out.models}) v->assign(band.brick_count(), 0);
+  for (auto* v : {&out.fitted, &out.heights, &out.models, &out.facing_fits}) v->assign(band.brick_count(), 0);
   if (settings.noisy_height) {
     out.raw_second.assign(band.active_voxel_count(), unset);
     out.gain.assign(band.active_voxel_count(), 0.0f);
   }
-  auto& [offset, moves, height_offset, spread, fitted, heights, models, residual, large_weight, raw_second, gain] = out;
+  auto& [offset, moves, height_offset, spread, fitted, heights, models, residual, large_weight, facing_fits, raw_second,
+         gain] = out;
   tbb::parallel_for(tbb::blocked_range<std::uint32_t>(0, std::uint32_t(band.brick_count()), 8),
                     [&](const tbb::blocked_range<std::uint32_t>& r) {
                       progress.check("reconstruct snap");
@@ -156,6 +172,7 @@ FrontOffsets front_offsets(const NarrowBand& band, const PointIndex& index, cons
                           height_offset[fv.i] = float(std::clamp(second - fv.u, -h, h));
                           spread[b] += double(fit.spread);
                           ++fitted[b];
+                          facing_fits[b] += sf.facing_away > 0;
                         }
                       }
                     });
@@ -231,7 +248,8 @@ SnapPass snap_to_fits(NarrowBand& band, const PointIndex& index, const SnapSetti
                       const std::vector<float>& coarse_curvature, const ProgressHook& progress) {
   const double h = band.voxel_size();
   FrontOffsets fronts = front_offsets(band, index, settings, coarse, coarse_curvature, progress);
-  auto& [offset, moves, height_offset, spread, fitted, heights, models, residual, large_weight, raw_second, gain] = fronts;
+  auto& [offset, moves, height_offset, spread, fitted, heights, models, residual, large_weight, facing_fits, raw_second,
+         gain] = fronts;
   // 2. Each voxel moves by the mean offset of its 3x3x3 neighbourhood: the offset is nearly
   // constant along normals, so this averages the fits tangentially (their noise / ~3).
   // Only voxels next to the front may change sign: no new bubbles or handles away from it
@@ -297,6 +315,7 @@ SnapPass snap_to_fits(NarrowBand& band, const PointIndex& index, const SnapSetti
   pass.clean = clean;
   pass.height_fits = height_n;
   for (const std::uint32_t m : models) pass.models += m;
+  for (const std::uint32_t f : facing_fits) pass.facing_fits += f;
   for (std::size_t b = 0; b < change.size(); ++b) {
     pass.mean_change += change[b];
     pass.voxels += count[b];

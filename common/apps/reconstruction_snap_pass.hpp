@@ -72,6 +72,7 @@ struct SnapPass {
   std::uint64_t models = 0;     // sheet fits made for them (fit_voxels)
   std::uint64_t height_fits = 0;  // of them with a usable height fit
   std::uint64_t refused = 0;    // sign changes refused (not simple: they would change the topology)
+  std::uint64_t facing_fits = 0;  // fits that left out points facing away (SnapSettings::facing_points)
   std::vector<std::uint64_t> moved;  // brick_key (sorted) of the bricks whose voxels moved more than settings.moved_limit on average
   // brick_key (sorted) of the bricks whose soft-scale height fits kept their largest patch
   // with a mean weight of at least kWidenWeight (soft_scales passes only).
@@ -99,6 +100,7 @@ struct SnapSettings {
   // When set: the height fits of these bricks (brick_key, sorted) take widened_neighbors points.
   const std::vector<std::uint64_t>* widen = nullptr;
   int widened_neighbors = 0;
+  bool facing_points = true;     // fits leave out the points facing away from the front (point_facing)
 };
 
 // One snap pass (apps/reconstruction.hpp describes it): every voxel with |u| < window h takes

@@ -42,7 +42,7 @@ nlohmann::json stages_json(const std::vector<apps::ReconstructionStage>& stages)
                       {"smoothing", s.smoothing},  {"second_order", s.second_order},
                       {"height_fits", s.height_fits}, {"height_neighbors", s.height_neighbors},
                       {"refused_flips", s.refused_flips}, {"dropped_components", s.dropped_components},
-                      {"buried_points", s.buried_points}, {"carved_regions", s.carved_regions}, {"pierced_regions", s.pierced_regions}, {"webs_cut", s.webs_cut}, {"web_tunnels", s.web_tunnels}, {"refit_bricks", s.refit_bricks}, {"widened_bricks", s.widened_bricks},
+                      {"buried_points", s.buried_points}, {"carved_regions", s.carved_regions}, {"pierced_regions", s.pierced_regions}, {"webs_cut", s.webs_cut}, {"web_tunnels", s.web_tunnels}, {"refit_bricks", s.refit_bricks}, {"widened_bricks", s.widened_bricks}, {"facing_fits", s.facing_fits},
                       {"carved_voxels", s.carved_voxels},
                       {"active_voxels", s.active_voxels},
                       {"fit_voxels", s.fit_voxels}, {"fit_models", s.fit_models}, {"seconds", s.seconds},

@@ -10,10 +10,12 @@
 //                 snap_passes = 1  clean_final_passes = 2  tolerance = 0.01  shell_offset = 1
 //                 guard_flow = yes  guard_snaps = yes  free_distance = 1  carve_gaps = yes  pierce_tunnels = yes  narrow_gaps = yes
 //                 cut_webs = yes  web_tunnels = yes  denoised_clearance = yes  refit_moved = yes  widen_smooth = yes
+//                 facing_points = yes
 //                 accuracy_samples = 100000 }
 //   (guard_*: keep the start shell's topology in the coarse flow / the snaps; free_distance:
 //   coarse voxels from the nearest sample beyond which the flow may change it; carve_gaps,
-//   pierce_tunnels, narrow_gaps, cut_webs, web_tunnels, denoised_clearance, refit_moved, widen_smooth:
+//   pierce_tunnels, narrow_gaps, cut_webs, web_tunnels, denoised_clearance, refit_moved, widen_smooth,
+//   facing_points:
 //   apps/reconstruction.hpp's options)
 // The raster's resolution / voxel_size / band are the final level's; with neither resolution
 // nor voxel_size the resolution follows from the points (stats: reconstruct.resolution,
@@ -35,7 +37,7 @@ namespace levelset::jobs {
 void run_reconstruct_job(JobContext& ctx) {
   const config::Set& in = ctx.section("input", {"points", "sample", "sample_mesh", "count", "noise", "seed"});
   const config::Set& s = ctx.section("reconstruct", {"levels", "neighbors", "curvature_weight", "max_steps", "snap_passes",
-                                                     "clean_final_passes", "guard_flow", "guard_snaps", "free_distance", "carve_gaps", "pierce_tunnels", "narrow_gaps", "cut_webs", "web_tunnels", "denoised_clearance", "refit_moved", "widen_smooth", "tolerance", "shell_offset", "accuracy_samples"});
+                                                     "clean_final_passes", "guard_flow", "guard_snaps", "free_distance", "carve_gaps", "pierce_tunnels", "narrow_gaps", "cut_webs", "web_tunnels", "denoised_clearance", "refit_moved", "widen_smooth", "facing_points", "tolerance", "shell_offset", "accuracy_samples"});
   const int given = (ctx.has(in, "points") ? 1 : 0) + (ctx.has(in, "sample") ? 1 : 0) + (ctx.has(in, "sample_mesh") ? 1 : 0);
   if (given != 1)
     throw Error(ErrorCode::InvalidArgument, ctx.options().name,
@@ -65,6 +67,7 @@ void run_reconstruct_job(JobContext& ctx) {
   o.denoised_clearance = ctx.flag(s, "denoised_clearance", o.denoised_clearance);
   o.refit_moved = ctx.flag(s, "refit_moved", o.refit_moved);
   o.widen_smooth = ctx.flag(s, "widen_smooth", o.widen_smooth);
+  o.facing_points = ctx.flag(s, "facing_points", o.facing_points);
   o.tolerance = ctx.number(s, "tolerance", o.tolerance, 1e-9, 10.0);
   o.shell_offset = ctx.number(s, "shell_offset", o.shell_offset, 1.0, 16.0);
   o.progress = ctx.options().progress;

@@ -16,7 +16,7 @@
 //   --meshes a.off,b.off (only these)  --max-meshes N  --ours (no Poisson)  --list (the meshes
 //   and their measurements only)  --jsonl FILE (one record per case, appended)
 //   --cache DIR (Poisson's results by case, default reconstruct-sweep-cache; reused).
-//   Development: --levels L, --shell-offset S, --curvature-weight W, --free-distance F, --no-carve, --no-web-tunnels, --no-refit-moved, --no-widen-smooth (reconstruction options);
+//   Development: --levels L, --shell-offset S, --curvature-weight W, --free-distance F, --no-carve, --no-web-tunnels, --no-refit-moved, --no-widen-smooth, --no-facing-points (reconstruction options);
 //   --keep DIR writes each case's points (KEY-points.xyz) and our surface (KEY-ours.ply);
 //   --log: the reconstruction's per-level lines with each level's topology on stderr.
 #include <algorithm>
@@ -68,6 +68,7 @@ struct SweepOptions {
   bool no_web_tunnels = false;
   bool no_refit_moved = false;
   bool no_widen_smooth = false;
+  bool no_facing_points = false;
 };
 
 template <class T>
@@ -110,6 +111,7 @@ SweepOptions parse(int argc, char** argv) {
     else if (arg == "--no-web-tunnels") o.no_web_tunnels = true;
     else if (arg == "--no-refit-moved") o.no_refit_moved = true;
     else if (arg == "--no-widen-smooth") o.no_widen_smooth = true;
+    else if (arg == "--no-facing-points") o.no_facing_points = true;
   }
   return o;
 }
@@ -285,6 +287,7 @@ CaseResult run_case(const SweepMesh& m, const std::vector<Vec3d>& truth_samples,
   ro.web_tunnels = !o.no_web_tunnels;
   ro.refit_moved = !o.no_refit_moved;
   ro.widen_smooth = !o.no_widen_smooth;
+  ro.facing_points = !o.no_facing_points;
   if (o.log) {
     ro.log = [](const std::string& line) { std::fprintf(stderr, "  %s\n", line.c_str()); };
     ro.log_topology = true;
