@@ -122,7 +122,7 @@ LocalFit one_sided_fit(const PointIndex& index, const Vec3d& x, const Vec3d& n, 
 // 2 kappa sigma^2 (kappa the half mean curvature: one kappa sigma^2 through the noise in the
 // tangential coordinates, about one more through the choice of the nearest points, whose rim
 // keeps the points the noise moved toward the tangent plane); c0 is corrected by a multiple of
-// the fitted kappa sigma^2 (point_distance.cpp correct_for_noise), at most by sigma / 2. select: the
+// the fitted kappa sigma^2 (sheet_fit.cpp correct_for_noise), at most by sigma / 2. select: the
 // height fit's points are chosen without a bias toward the tangent plane: the band is at least
 // 3 sigma, and the points lie in a tangential disc the k_height ball holds whole (a ball cuts the
 // slab's corners, so it keeps a curved patch's rim points by their height). The scale choice's

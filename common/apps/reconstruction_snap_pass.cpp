@@ -58,7 +58,7 @@ constexpr double kSmoothingGain = 4.0;
 constexpr double kFacingDepth = 0.5;
 constexpr double kFacingNoiseDepth = 3.0;
 // The redone noise correction's change is at most this many of the pass's own noise sigmas
-// (as the fit's own bound, point_distance.cpp).
+// (as the fit's own bound, sheet_fit.cpp).
 constexpr double kMaxNoiseShiftRedo = 0.5;
 
 // Step 1 of a pass: the front offset e = clamp(s - u, +-h) of every voxel within the window
