@@ -99,7 +99,11 @@
 //   more pass on the bricks whose voxels the last pass moved more than 0.25 voxel on average,
 //   where one pass of neighbourhood-averaged offsets stops short; widen_smooth: a later pass
 //   on a level gives 5/3 the points to the soft-scale height fits of the bricks where the pass
-//   before kept their largest patch with a mean weight of at least 0.4)
+//   before kept their largest patch with a mean weight of at least 0.4; facing_points: every
+//   pass first gives each point within max(0.5 voxel, 3 sigma) of the front the band's unit
+//   gradient there, and a voxel's fits leave out its nearest points that face away from its
+//   normal: the far side of a part thinner than the fits' band and the other wall of a narrow
+//   gap, which under noise sank the fits toward the part's middle)
 //   stop early when the mean |change| of the snapped voxels is below tolerance. A level's
 //   first pass may run before any level has read the noise; where its reading asks for 4 times
 //   the height fits' points or more, the final level, and a level whose fits read more noise
