@@ -42,5 +42,4 @@ struct Moments {
   }
 };
 
-
 }  // namespace levelset::apps::detail
