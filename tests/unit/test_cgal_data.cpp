@@ -161,7 +161,8 @@ const std::set<std::string> kKnownBadMeshes = {
 
 TEST(CgalData, EveryMeshReadsWithCountsFromAnIndependentScan) {
   const fs::path dir = cgal_data() / "meshes";
-  if (!fs::is_directory(dir)) GTEST_SKIP() << "CGAL sample data not found at " << dir;
+  ASSERT_TRUE(fs::is_directory(dir))
+      << "CGAL sample data not found at " << dir << " (install-deps.sh installs it)";
   omerr().disable();
   omlog().disable();
   std::set<std::string> rejected;
@@ -243,7 +244,8 @@ const std::map<std::string, ErrorCode> kKnownBadPointClouds = {
 
 TEST(CgalData, EveryPointCloudReadsWithCountsFromAnIndependentScan) {
   const fs::path dir = cgal_data() / "points_3";
-  if (!fs::is_directory(dir)) GTEST_SKIP() << "CGAL sample data not found at " << dir;
+  ASSERT_TRUE(fs::is_directory(dir))
+      << "CGAL sample data not found at " << dir << " (install-deps.sh installs it)";
   std::map<std::string, ErrorCode> rejected;
   int checked = 0;
   for (const fs::path& path : files_in(dir)) {
@@ -292,7 +294,8 @@ TEST(CgalData, EveryPointCloudReadsWithCountsFromAnIndependentScan) {
 
 TEST(CgalData, LargestMeshReadTime) {
   const fs::path dir = cgal_data() / "meshes";
-  if (!fs::is_directory(dir)) GTEST_SKIP() << "CGAL sample data not found at " << dir;
+  ASSERT_TRUE(fs::is_directory(dir))
+      << "CGAL sample data not found at " << dir << " (install-deps.sh installs it)";
   fs::path largest;
   std::uintmax_t size = 0;
   for (const fs::path& path : files_in(dir)) {

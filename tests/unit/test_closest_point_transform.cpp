@@ -217,7 +217,8 @@ std::filesystem::path cgal_mesh(const char* name) {
 
 TEST(ClosestPointTransform, CgalKnotSignAgreesWithRayParity) {
   const auto path = cgal_mesh("knot.off");
-  if (!std::filesystem::exists(path)) GTEST_SKIP() << "CGAL data not installed: " << path;
+  ASSERT_TRUE(std::filesystem::exists(path))
+      << "CGAL data not installed: " << path << " (install-deps.sh installs it)";
   const TriangleMesh mesh = read_mesh(path).mesh;
   const CptResult r = run_cpt(mesh, 128);
   expect_exact_band(mesh, r, 29);
@@ -242,7 +243,8 @@ TEST(ClosestPointTransform, CgalKnotSignAgreesWithRayParity) {
 
 TEST(ClosestPointTransform, CgalElephantWithHolesDeepInsideAndFarOutside) {
   const auto path = cgal_mesh("elephant-with-holes.off");
-  if (!std::filesystem::exists(path)) GTEST_SKIP() << "CGAL data not installed: " << path;
+  ASSERT_TRUE(std::filesystem::exists(path))
+      << "CGAL data not installed: " << path << " (install-deps.sh installs it)";
   const TriangleMesh mesh = read_mesh(path).mesh;
   const CptResult r = run_cpt(mesh, 128);
   // Reference: the elephant without holes is CGAL's elephant.off; deep inside = inside it and

@@ -117,7 +117,8 @@ TEST(Fairing, CgalMeshCurvatureVarianceDrops) {
   const char* env = std::getenv("LEVELSET_CGAL_DATA");
   const fs::path dir = (env != nullptr && *env != '\0' ? fs::path(env) : fs::path(LEVELSET_CGAL_DATA)) / "meshes";
   const fs::path file = dir / "elephant.off";
-  if (!fs::exists(file)) GTEST_SKIP() << "CGAL data not installed: " << file;
+  ASSERT_TRUE(fs::exists(file)) << "CGAL data not installed: " << file
+                                << " (install-deps.sh installs it)";
   const TriangleMesh mesh = read_mesh(file).mesh;
   CptOptions co;
   co.frame = frame_for_resolution(mesh.bounds(), 64, 3.0);

@@ -308,7 +308,8 @@ fs::path cgal_images() {
 
 TEST(ImageReader, CgalSampleImages) {
   const fs::path dir = cgal_images();
-  if (!fs::is_directory(dir)) GTEST_SKIP() << "CGAL sample data not found at " << dir;
+  ASSERT_TRUE(fs::is_directory(dir))
+      << "CGAL sample data not found at " << dir << " (install-deps.sh installs it)";
   const ImageReadResult skull = read_image(dir / "skull_2.9.inr");
   EXPECT_EQ(skull.image.nx, 64);
   EXPECT_EQ(skull.image.nz, 64);

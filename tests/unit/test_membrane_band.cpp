@@ -78,7 +78,8 @@ std::uint64_t invariant_violations(const NarrowBand& band) {
 
 TEST(MembraneBand, EveryOpenCgalMeshGivesAClosedSurface) {
   const fs::path dir = test::cgal_meshes_dir();
-  if (!fs::is_directory(dir)) GTEST_SKIP() << "CGAL data meshes not installed: " << dir;
+  ASSERT_TRUE(fs::is_directory(dir))
+      << "CGAL data meshes not installed: " << dir << " (install-deps.sh installs it)";
   std::vector<fs::path> files;
   for (const auto& entry : fs::directory_iterator(dir))
     if (entry.is_regular_file()) files.push_back(entry.path());

@@ -309,7 +309,8 @@ TEST(MarchingCubesIso, OffsetIsoGivesOffsetSphere) {
 
 TEST(MarchingCubesCgal, KnotIsGenusOneWithinOneVoxel) {
   const std::filesystem::path path = std::filesystem::path(LEVELSET_CGAL_DATA) / "meshes" / "knot.off";
-  if (!std::filesystem::exists(path)) GTEST_SKIP() << "CGAL data not installed: " << path;
+  ASSERT_TRUE(std::filesystem::exists(path))
+      << "CGAL data not installed: " << path << " (install-deps.sh installs it)";
   const TriangleMesh input = test::load_cgal_mesh("knot.off");
   CptOptions o;
   o.frame = frame_for_resolution(input.bounds(), 128, 3.0);

@@ -107,7 +107,8 @@ std::size_t stride_for(const TriangleMesh& from, const TriangleMesh& to) {
 
 TEST(CgalSurfaces, ClosedManifoldInputsKeepTopologyAtR128BothMethods) {
   const fs::path dir = test::cgal_meshes_dir();
-  if (!fs::is_directory(dir)) GTEST_SKIP() << "CGAL data meshes not installed: " << dir;
+  ASSERT_TRUE(fs::is_directory(dir))
+      << "CGAL data meshes not installed: " << dir << " (install-deps.sh installs it)";
   std::vector<fs::path> files;
   for (const auto& entry : fs::directory_iterator(dir))
     if (entry.is_regular_file() && entry.path().extension() == ".off") files.push_back(entry.path());
@@ -179,7 +180,8 @@ TEST(CgalSurfaces, ClosedManifoldInputsKeepTopologyAtR128BothMethods) {
 
 TEST(CgalSurfaces, HausdorffWithinOneVoxelForKnotAndBunny) {
   const fs::path dir = test::cgal_meshes_dir();
-  if (!fs::is_directory(dir)) GTEST_SKIP() << "CGAL data meshes not installed: " << dir;
+  ASSERT_TRUE(fs::is_directory(dir))
+      << "CGAL data meshes not installed: " << dir << " (install-deps.sh installs it)";
   int checked = 0;
   for (const std::string name : {"knot.off", "bunny00.off"}) {
     const fs::path path = dir / name;
