@@ -158,8 +158,10 @@ struct HeightNoise {
 // offsets' difference reveals beyond its noise (for nested fits Var(small - large) ~
 // v_small - v_large: weight min(1, (v_small - v_large) / D^2)); smooth patches keep the large
 // fit's averaging, detail falls back toward the small fits without a hard threshold's
-// undetected bias (tests/unit/test_sheet_fit_scales.cpp). has_height is false
-// (height_offset 0) with fewer than 10 kept points or an ill-conditioned system. Thread-safe.
+// undetected bias (tests/unit/test_sheet_fit_scales.cpp); where the choice keeps at least half
+// the weight on the largest patch, the points are chosen again in the band about its quadric
+// (not the plane's, which cuts a curved patch's rim) and the choice is made again. has_height is
+// false (height_offset 0) with fewer than 10 kept points or an ill-conditioned system. Thread-safe.
 struct SheetFit {
   LocalFit plane;
   double height_offset = 0.0;
