@@ -54,7 +54,7 @@ constexpr double kNoiseBand = 3.0;
 // biased fit, and a band about it would keep only the points that agree with it (the choice
 // then reads no detail). bench_reconstruct --sweep, 0.1 % noise, seed 1, 20k points: median
 // ratio 0.813 -> 0.794 (11 cases better by more than 1 %, 5 worse; bear_bis -2.4 %, retinal
-// -3.9 %, knot1 +2.3 %); 50k: 0.702 -> 0.690 (4 better, 7 worse: knot1 +4.1 %, turbine
+// -3.9 %, knot1 +2.3 %); 50k: 0.702 -> 0.690 (4 better, 8 worse: knot1 +3.8 %, turbine
 // +2.2 %, fandisk_large +2.0 %, cheese -4.3 %, retinal -4.1 %). The band about every fit's
 // quadric (weight 0): 20k 0.752, but 13 worse (knot2 +11 %, bull, femur, triceratops +4 %).
 constexpr double kCurvedBandWeight = 0.5;
@@ -81,6 +81,11 @@ double median_of(std::array<double, 8> v, int size) {
   for (int i = 1; i < size; ++i)  // insertion sort of at most 8 values
     for (int j = i; j > 0 && v[std::size_t(j)] < v[std::size_t(j - 1)]; --j) std::swap(v[std::size_t(j)], v[std::size_t(j - 1)]);
   return size % 2 == 1 ? v[std::size_t(size / 2)] : 0.5 * (v[std::size_t(size / 2 - 1)] + v[std::size_t(size / 2)]);
+}
+
+// The quadric z = c0 + c1 u + c2 v + c3 u^2 + c4 uv + c5 v^2 of the height fits at (u, v).
+double quadric_at(const std::array<double, 6>& c, double u, double v) {
+  return c[0] + c[1] * u + c[2] * v + c[3] * u * u + c[4] * u * v + c[5] * v * v;
 }
 
 // Drops the points facing away from n (see sheet_fit) from the first `count` of idx and d2,
@@ -250,7 +255,7 @@ HeightFit quadric_height(const TangentPoint* pts, int used) {
   for (int i = 0; i < used; ++i) {
     const double u = pts[i].xi * inv_r, v = pts[i].eta * inv_r;
     const double w = weight[std::size_t(i)];
-    const double z = r[0] + r[1] * u + r[2] * v + r[3] * u * u + r[4] * u * v + r[5] * v * v;
+    const double z = quadric_at(r, u, v);
     const double e = pts[i].z - z;
     wsum += w;
     rsum += w * e * e;
@@ -291,9 +296,7 @@ int height_points(const PointIndex& index, const Vec3d& x, const Vec3d& n, const
     const Vec3d v = index.points()[sh.idx[std::size_t(i)]] - x;
     const TangentPoint p{dot(v, e1), dot(v, e2), dot(v, n)};
     if (about) {
-      const double u = p.xi * about->inv_r, w = p.eta * about->inv_r;
-      const auto& c = about->c;
-      const double zq = c[0] + c[1] * u + c[2] * w + c[3] * u * u + c[4] * u * w + c[5] * w * w;
+      const double zq = quadric_at(about->c, p.xi * about->inv_r, p.eta * about->inv_r);
       if (std::abs(p.z - zq) > band) continue;
     } else if (std::abs(sh.t[std::size_t(i)] - sh.ref) > band) {
       continue;
@@ -489,7 +492,7 @@ SheetFit SheetModel::at(const Vec3d& y) const {
   // y's foot on the tangent plane (u, v) and its height zeta over x; the quadric relative to
   // y is z - zeta, so y's offset is -(z(u, v) - zeta) times the cosine of the slope there.
   const double u = dot(d, e1) * inv_r, v = dot(d, e2) * inv_r, zeta = dot(d, n);
-  const double z = c[0] + c[1] * u + c[2] * v + c[3] * u * u + c[4] * u * v + c[5] * v * v;
+  const double z = quadric_at(c, u, v);
   const double zu = c[1] + 2.0 * c[3] * u + c[4] * v, zv = c[2] + c[4] * u + 2.0 * c[5] * v;
   const double slope2 = (zu * zu + zv * zv) * inv_r * inv_r;
   f.height_offset = -(z - zeta) / std::sqrt(1.0 + slope2);
