@@ -46,6 +46,21 @@ class NearbyPoints {
   int k_ = 0;
   std::vector<Candidate> candidates_;
   std::vector<std::pair<std::uint32_t, double>> found_;  // radius query scratch
+  // k_nearest for the prepared k: the points within a bound gathered and sorted (see there);
+  // last_ holds the last such query's result (positions in candidates_, nearest first).
+  struct Gathered {
+    double d;
+    std::uint32_t index;
+    std::uint16_t at;
+  };
+  int k_nearest_bounded(const Vec3d& x, double offset, int k, std::uint32_t* indices,
+                        double* distances_squared) const;
+  // Fewer than the prepared k: a running sorted list over the candidates in their order.
+  int k_nearest_running(const Vec3d& x, double offset, int k, std::uint32_t* indices,
+                        double* distances_squared) const;
+  mutable std::vector<std::uint16_t> last_;
+  mutable std::vector<Gathered> gathered_, sorted_;
+  mutable std::vector<std::uint32_t> bucket_start_;
 };
 
 }  // namespace levelset::apps

@@ -6,20 +6,22 @@
 #include <cmath>
 #include <span>
 
+#include "apps/height_quadric.hpp"
 #include "apps/nearby_points.hpp"
 #include "apps/point_distance.hpp"
 #include "apps/point_fit_detail.hpp"
 
 namespace levelset::apps {
 
+using detail::HeightFit;
 using detail::kMaxNeighbors;
 using detail::Moments;
+using detail::quadric_at;
+using detail::quadric_height;
+using detail::TangentPoint;
 
 namespace {
 
-// Cholesky pivots below this fraction of the largest diagonal entry: the points do not span
-// the quadric's six functions (e.g. all on a line across a thin part).
-constexpr double kHeightConditioning = 1e-6;
 // Height fits over at least 2 kSmallPatch points also fit the nearest 1 / kPatchRatio of
 // them (at least kSmallPatch) and take that offset when the two differ by more than
 // kPatchConfidence standard errors of the small fit (sheet_fit).
@@ -83,11 +85,6 @@ double median_of(std::array<double, 8> v, int size) {
   return size % 2 == 1 ? v[std::size_t(size / 2)] : 0.5 * (v[std::size_t(size / 2 - 1)] + v[std::size_t(size / 2)]);
 }
 
-// The quadric z = c0 + c1 u + c2 v + c3 u^2 + c4 uv + c5 v^2 of the height fits at (u, v).
-double quadric_at(const std::array<double, 6>& c, double u, double v) {
-  return c[0] + c[1] * u + c[2] * v + c[3] * u * u + c[4] * u * v + c[5] * v * v;
-}
-
 // Drops the points facing away from n (see sheet_fit) from the first `count` of idx and d2,
 // keeping their order; returns how many are left (all `count` when none would be).
 int drop_facing_away(std::span<const Vec3f> facing, const Vec3d& n, int count, Sheet& s) {
@@ -138,38 +135,6 @@ LocalFit sheet_moments(const PointIndex& index, const Vec3d& x, const Sheet& sh,
   return f;
 }
 
-// Solves the symmetric positive definite system M c = r (N unknowns) by Cholesky; false when
-// a pivot falls below `relative` times the largest diagonal entry (ill-conditioned).
-template <int N>
-bool solve_spd(std::array<double, N * N>& M, std::array<double, N>& r, double relative) {
-  double scale = 0.0;
-  for (int i = 0; i < N; ++i) scale = std::max(scale, M[std::size_t(i * N + i)]);
-  if (!(scale > 0.0)) return false;
-  for (int j = 0; j < N; ++j) {
-    double d = M[std::size_t(j * N + j)];
-    for (int q = 0; q < j; ++q) d -= M[std::size_t(j * N + q)] * M[std::size_t(j * N + q)];
-    if (!(d > relative * scale)) return false;
-    const double l = std::sqrt(d);
-    M[std::size_t(j * N + j)] = l;
-    for (int i = j + 1; i < N; ++i) {
-      double v = M[std::size_t(i * N + j)];
-      for (int q = 0; q < j; ++q) v -= M[std::size_t(i * N + q)] * M[std::size_t(j * N + q)];
-      M[std::size_t(i * N + j)] = v / l;
-    }
-  }
-  for (int i = 0; i < N; ++i) {  // L y = r
-    double v = r[std::size_t(i)];
-    for (int q = 0; q < i; ++q) v -= M[std::size_t(i * N + q)] * r[std::size_t(q)];
-    r[std::size_t(i)] = v / M[std::size_t(i * N + i)];
-  }
-  for (int i = N - 1; i >= 0; --i) {  // L^T c = y
-    double v = r[std::size_t(i)];
-    for (int q = i + 1; q < N; ++q) v -= M[std::size_t(q * N + i)] * r[std::size_t(q)];
-    r[std::size_t(i)] = v / M[std::size_t(i * N + i)];
-  }
-  return true;
-}
-
 }  // namespace
 
 LocalFit one_sided_fit(const PointIndex& index, const Vec3d& x, const Vec3d& n, int k, double min_band) {
@@ -177,102 +142,6 @@ LocalFit one_sided_fit(const PointIndex& index, const Vec3d& x, const Vec3d& n, 
   find_sheet(index, nullptr, x, n, k, min_band, {}, sh);
   return sheet_moments(index, x, sh, sh.count);
 }
-
-namespace {
-
-// A point in the tangent frame of the fit: tangential (xi, eta), height z along the normal.
-struct TangentPoint {
-  double xi, eta, z;
-};
-
-struct HeightFit {
-  bool ok = false;
-  double offset = 0.0;    // x's signed distance to the quadric (world)
-  double residual = 0.0;  // weighted RMS residual, corrected for the 6 coefficients (world)
-  double spread = 0.0;    // kWithSpread: standard error of c0 per unit noise, sqrt(y^T (sum w^2 phi phi^T) y), M y = e0
-  std::array<double, 6> c{};  // the quadric over (u, v) = (xi, eta) * inv_r
-  double inv_r = 0.0;
-};
-
-// The weighted least-squares quadric z = c0 + c1 u + ... + c5 v^2 (u, v the tangential
-// coordinates over the largest radius R among the first `used` points, weights exp(-rho^2 / R^2)).
-template <bool kWithSpread>
-HeightFit quadric_height(const TangentPoint* pts, int used) {
-  HeightFit f;
-  if (used < 10) return f;
-  double r2max = 0.0;
-  for (int i = 0; i < used; ++i) r2max = std::max(r2max, pts[i].xi * pts[i].xi + pts[i].eta * pts[i].eta);
-  if (!(r2max > 0.0)) return f;
-  const double inv_r = 1.0 / std::sqrt(r2max);
-  // The normal matrix sum w phi_a phi_b has only 15 distinct entries, the weighted moments
-  // sum w u^p v^q (p + q <= 4) of the monomials phi = (1, u, v, u^2, uv, v^2); each point's
-  // weight is kept for the residual.
-  std::array<double, 15> mom{}, mom2{};  // (p, q) in kMoment order; mom2 with w^2
-  std::array<double, 6> r{};
-  std::array<double, kMaxNeighbors> weight;
-  for (int i = 0; i < used; ++i) {
-    const double u = pts[i].xi * inv_r, v = pts[i].eta * inv_r;
-    const double w = std::exp(-(u * u + v * v));
-    weight[std::size_t(i)] = w;
-    const double uu = u * u, uv = u * v, vv = v * v;
-    const double m[15] = {1.0, u, v, uu, uv, vv, uu * u, uu * v, u * vv, vv * v, uu * uu, uu * uv, uu * vv, uv * vv, vv * vv};
-    for (int k = 0; k < 15; ++k) mom[std::size_t(k)] += w * m[k];
-    if constexpr (kWithSpread)
-      for (int k = 0; k < 15; ++k) mom2[std::size_t(k)] += w * w * m[k];
-    const double wz = w * pts[i].z;
-    r[0] += wz;
-    r[1] += wz * u;
-    r[2] += wz * v;
-    r[3] += wz * uu;
-    r[4] += wz * uv;
-    r[5] += wz * vv;
-  }
-  // The moment index of phi_a phi_b: monomial exponents added.
-  auto full = [](const std::array<double, 15>& moments) {
-    static constexpr int kP[6] = {0, 1, 0, 2, 1, 0}, kQ[6] = {0, 0, 1, 0, 1, 2};
-    // Index of u^p v^q in the moment list, by degree then by decreasing p.
-    auto index = [](int p, int q) { const int d = p + q; return d * (d + 1) / 2 + q; };
-    std::array<double, 36> m{};
-    for (int a = 0; a < 6; ++a)
-      for (int b = 0; b < 6; ++b) m[std::size_t(a * 6 + b)] = moments[std::size_t(index(kP[a] + kP[b], kQ[a] + kQ[b]))];
-    return m;
-  };
-  std::array<double, 36> L = full(mom);
-  if (!solve_spd<6>(L, r, kHeightConditioning)) return f;
-  double var = 0.0;
-  if constexpr (kWithSpread) {
-    std::array<double, 6> y{1.0, 0.0, 0.0, 0.0, 0.0, 0.0};
-    L = full(mom);
-    solve_spd<6>(L, y, kHeightConditioning);  // factorises as above: succeeds
-    const std::array<double, 36> S = full(mom2);
-    for (int a = 0; a < 6; ++a)
-      for (int b = 0; b < 6; ++b) var += y[std::size_t(a)] * S[std::size_t(a * 6 + b)] * y[std::size_t(b)];
-  }
-  // The quadric's weighted residual: the points' noise, free of the surface's curvature
-  // (which the quadric absorbs), corrected for the 6 fitted coefficients; about the fitted c0,
-  // before the noise correction (correct_for_noise) moves it.
-  double wsum = 0.0, rsum = 0.0;
-  for (int i = 0; i < used; ++i) {
-    const double u = pts[i].xi * inv_r, v = pts[i].eta * inv_r;
-    const double w = weight[std::size_t(i)];
-    const double z = quadric_at(r, u, v);
-    const double e = pts[i].z - z;
-    wsum += w;
-    rsum += w * e * e;
-  }
-  f.residual = std::sqrt(rsum / (wsum * (1.0 - 6.0 / double(used))));
-  // The surface crosses the normal line at x + z0 n; x's signed offset along the surface's
-  // normal is -z0 cos(tilt), the slope (z_xi, z_eta) = (r1, r2) / R.
-  const double slope2 = (r[1] * r[1] + r[2] * r[2]) * inv_r * inv_r;
-  f.offset = -r[0] / std::sqrt(1.0 + slope2);
-  f.spread = std::sqrt(std::max(0.0, var));
-  f.c = r;
-  f.inv_r = inv_r;
-  f.ok = true;
-  return f;
-}
-
-}  // namespace
 
 namespace {
 
@@ -365,11 +234,11 @@ ScaledFit blend_scales(const ScaledFit& large, const ScaledFit& smaller) {
 ScaledFit soft_scale_choice(const TangentPoint* pts, int used, const HeightFit& large) {
   const int half = std::max(kSmallPatch, used / 2), quarter = std::max(kSmallPatch, used / 4);
   if (used < 2 * half) return {large, 0.0, 1.0};
-  const HeightFit medium = quadric_height<true>(pts, half);
+  const HeightFit medium = quadric_height(pts, half, true);
   if (!medium.ok) return {large, 0.0, 1.0};
   ScaledFit out = blend_scales(with_variance(large), with_variance(medium));
   if (half >= 2 * quarter) {
-    const HeightFit small = quadric_height<true>(pts, quarter);
+    const HeightFit small = quadric_height(pts, quarter, true);
     if (small.ok) out = blend_scales(out, with_variance(small));
   }
   return out;
@@ -426,7 +295,7 @@ SheetModel sheet_model_from(const PointIndex& index, const NearbyPoints* near, c
   f.e2 = e2;
   std::array<TangentPoint, kMaxNeighbors> pts;  // the first `used` entries are written
   const int used = height_points(index, x, n, e1, e2, sh, k_height, noise, pts);
-  HeightFit fit = noise.soft ? quadric_height<true>(pts.data(), used) : quadric_height<false>(pts.data(), used);
+  HeightFit fit = quadric_height(pts.data(), used, noise.soft);
   if (!fit.ok) return f;
   // The patch's scale from the data (intersection of confidence intervals, Lepski): the
   // large patch averages the noise, but where the surface bends more than a quadric
@@ -440,7 +309,7 @@ SheetModel sheet_model_from(const PointIndex& index, const NearbyPoints* near, c
       // A smooth patch: its points chosen again in the band about the large fit's quadric
       // (the plane's band cuts a curved patch's rim) and the choice made again over them.
       const int again = height_points(index, x, n, e1, e2, sh, k_height, noise, pts, &fit);
-      const HeightFit refit = quadric_height<true>(pts.data(), again);
+      const HeightFit refit = quadric_height(pts.data(), again, true);
       if (refit.ok) {
         chosen = soft_scale_choice(pts.data(), again, refit);
         curved = true;
@@ -449,7 +318,7 @@ SheetModel sheet_model_from(const PointIndex& index, const NearbyPoints* near, c
     fit = chosen.fit;
     f.large_weight = chosen.large_weight;
   } else if (used >= 2 * small) {
-    const HeightFit small_fit = quadric_height<true>(pts.data(), small);
+    const HeightFit small_fit = quadric_height(pts.data(), small, true);
     if (small_fit.ok && std::abs(fit.offset - small_fit.offset) > kPatchConfidence * small_fit.residual * small_fit.spread) {
       fit = small_fit;
       f.large_weight = 0.0;

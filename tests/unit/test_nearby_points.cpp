@@ -1,11 +1,15 @@
 // NearbyPoints (apps/nearby_points.hpp): k-nearest queries answered from one radius query
 // around a centre must equal the kd-tree's, for positions anywhere within the reach (also at
 // its corners, where the bound is tight), for sets smaller than k, with duplicated points, and
-// off the reach (the tree's fallback); sheet_fit over it equals sheet_fit over the tree.
+// off the reach (the tree's fallback); sheet_fit over it equals sheet_fit over the tree; on a
+// lattice, where equal distances are everywhere, a walk of nearby queries (each bounded by the
+// one before) returns exactly the k smallest by (distance, index).
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <array>
 #include <random>
+#include <utility>
 #include <vector>
 
 #include "apps/nearby_points.hpp"
@@ -105,6 +109,60 @@ TEST(NearbyPoints, CrowdedNeighbourhoodFallsBackToTheTree) {
   EXPECT_TRUE(index.within({0.0, 0.0, 0.0}, 0.25, 500, found));
   EXPECT_EQ(found.size(), 3u);  // 0, 0.1 and 0.2
   expect_same_as_tree(index, {0.3, 0.0, 0.0}, 0.1, 46, 13);
+}
+
+// The k smallest (squared distance, index) pairs by brute force, the distances computed as
+// PointIndex does (x - p per axis, squared and added in axis order).
+std::vector<std::pair<double, std::uint32_t>> brute_k_nearest(const std::vector<Vec3d>& points,
+                                                              const Vec3d& x, int k) {
+  std::vector<std::pair<double, std::uint32_t>> all;
+  for (std::uint32_t i = 0; i < points.size(); ++i) {
+    double d = 0.0, diff = x.x - points[i].x;
+    d += diff * diff;
+    diff = x.y - points[i].y;
+    d += diff * diff;
+    diff = x.z - points[i].z;
+    d += diff * diff;
+    all.push_back({d, i});
+  }
+  std::sort(all.begin(), all.end());
+  all.resize(std::size_t(k));
+  return all;
+}
+
+TEST(NearbyPoints, LatticeWalkBreaksTiesByIndex) {
+  // A 41 x 41 lattice of spacing 1 in z = 0, every 7th point doubled: most query positions
+  // below see several points at exactly the same distance.
+  std::vector<Vec3d> p;
+  for (int j = 0; j <= 40; ++j)
+    for (int i = 0; i <= 40; ++i) {
+      p.push_back({double(i), double(j), 0.0});
+      if ((i + 41 * j) % 7 == 0) p.push_back(p.back());
+    }
+  const PointIndex index(p);
+  for (const int k : {8, 46, 132}) {
+    NearbyPoints near(index);
+    const Vec3d centre{20.0, 20.0, 0.0};
+    near.prepare(centre, 4.0, k);
+    // A walk in half-lattice steps over the reach (on lattice points, midpoints, cell centres,
+    // and one step off the plane), then a jump back to the centre.
+    std::vector<Vec3d> walk;
+    for (int a = -5; a <= 5; ++a)
+      for (int b = -5; b <= 5; ++b)
+        walk.push_back(centre + Vec3d{0.5 * a, 0.5 * b, (a + b) % 3 == 0 ? 0.5 : 0.0});
+    walk.push_back(centre);
+    for (const Vec3d& x : walk) {
+      if (length(x - centre) > 4.0) continue;
+      std::array<std::uint32_t, 256> idx{};
+      std::array<double, 256> d2{};
+      ASSERT_EQ(near.k_nearest(x, k, idx.data(), d2.data()), k);
+      const auto want = brute_k_nearest(p, x, k);
+      for (int i = 0; i < k; ++i) {
+        ASSERT_EQ(d2[std::size_t(i)], want[std::size_t(i)].first) << "k " << k << " rank " << i;
+        ASSERT_EQ(idx[std::size_t(i)], want[std::size_t(i)].second) << "k " << k << " rank " << i;
+      }
+    }
+  }
 }
 
 TEST(NearbyPoints, SheetFitIsTheSame) {
