@@ -32,6 +32,10 @@ constexpr double kAttractionGain = 3.0;
 // fraction of them is a stray (drop_unsupported_components).
 constexpr double kMinSupport = 0.5;
 constexpr double kSupportDistance = 1.5;
+// A speck: a component of at most kSpeckVoxels voxels none of which lies kSpeckDepth voxels
+// or more from the zero level (drop_unsupported_components).
+constexpr std::uint64_t kSpeckVoxels = 8;
+constexpr double kSpeckDepth = 0.1;
 // The guard's pinned rule: a thin inside voxel with a point within this many coarse voxels.
 constexpr double kPinDistance = 0.75;
 
@@ -101,14 +105,9 @@ evolve::SpeedFunction fit_speed(const NarrowBand& cache, const std::vector<Local
   return s;
 }
 
-// Components the data do not support: a component of the inside or outside voxel set
-// (not the exterior, not the inside component with the largest front) whose front voxels have a point
-// within `support` for less than kMinSupport of them. They arise on the coarse level where
-// the front crossed a gap between parts far from the data (the free_distance rule lets the
-// topology change there), and the guard keeps them once they reach the data (measured: the
-// knot at R = 128 with 0.2% noise kept a blob 2 coarse voxels off the surface, 5% of its
-// front near a point). Each is turned to the other sign; the caller redistances. Components
-// with voxels off the band are kept (too large to be strays). Returns how many were turned.
+}  // namespace
+
+// Stray components and specks turned (reconstruction_parts.hpp).
 std::uint64_t drop_unsupported_components(NarrowBand& band, const PointIndex& index, double support,
                                           const ProgressHook& progress) {
   SignComponentsOptions sco;
@@ -120,11 +119,23 @@ std::uint64_t drop_unsupported_components(NarrowBand& band, const PointIndex& in
     if (comps.components[c].inside &&
         (largest == comps.components.size() || comps.components[c].front.size() > comps.components[largest].front.size()))
       largest = c;
+  // deep[c]: component c has a voxel kSpeckDepth voxels or more from the zero level.
+  std::vector<std::uint8_t> deep(comps.components.size(), 0);
+  const float speck_depth = float(kSpeckDepth * band.voxel_size());
+  for (std::uint32_t b = 0; b < band.brick_count(); ++b)
+    band.for_each_active_in_brick(b, [&](const Coord& c, float v) {
+      if (std::abs(v) >= speck_depth) deep[std::size_t(comps.label[comps.index_of(c)])] = 1;
+    });
   std::vector<std::uint8_t> drop(comps.components.size(), 0);
   std::uint64_t dropped = 0;
   for (std::size_t c = 0; c < comps.components.size(); ++c) {
     const SignComponent& comp = comps.components[c];
     if (c == largest || comp.touches_box || !comp.all_active || comp.front.empty()) continue;
+    if (comp.voxels <= kSpeckVoxels && !deep[c]) {
+      drop[c] = 1;
+      ++dropped;
+      continue;
+    }
     std::size_t near = 0;
     for (const Coord& f : comp.front)
       if (index.nearest(band.world(f)).distance <= support) ++near;
@@ -147,8 +158,6 @@ std::uint64_t drop_unsupported_components(NarrowBand& band, const PointIndex& in
   band.swap_values(values);
   return dropped;
 }
-
-}  // namespace
 
 LevelOutput flow_level(NarrowBand band, const PointIndex& index, const ReconstructionOptions& o, int levels,
                        ReconstructionStage stage) {
