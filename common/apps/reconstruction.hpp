@@ -196,8 +196,8 @@ struct ReconstructionStage {
   std::uint64_t height_fits = 0;  // snap: fits whose height fit was usable (all passes)
   int height_neighbors = 0;     // snap: points per height fit (last pass)
   std::uint64_t refused_flips = 0;  // sign changes refused as not simple (topology kept), all steps / passes
-  std::uint64_t dropped_components =
-      0;  // coarsest level: components without data, and specks, turned to the other sign
+  // coarsest level: components without data, and specks, turned to the other sign
+  std::uint64_t dropped_components = 0;
   std::uint64_t buried_points = 0;  // finer levels: points buried inside the upsampled front
   int carved_regions = 0;           // finer levels: closed gaps reopened (turned outside)
   int pierced_regions = 0;          // of them reopened whole, tunnels allowed (pierce_tunnels), or webs cut
