@@ -102,19 +102,24 @@ void validate(const std::vector<Vec3d>& points, const ReconstructionOptions& o) 
 std::string stage_line(const ReconstructionStage& stage) {
   char line[640];
   std::snprintf(line, sizeof line,
-                "level %d: h %.4g, shell offset %.2f voxel, %s %d, change %.4f voxel, noise %.3f voxel (height fits %.3f), "
-                "%s (%d points), smoothing %d, %llu buried points, %d regions carved (%d pierced, %d webs cut, %llu voxels), %d web tunnels, %llu voxels, "
+                "level %d: h %.4g, shell offset %.2f voxel, %s %d, change %.4f voxel, noise %.3f "
+                "voxel (height fits %.3f), "
+                "%s (%d points), smoothing %d, %llu buried points, %d regions carved (%d pierced, "
+                "%d webs cut, %d sheets cut, %llu voxels), %d web tunnels, %llu voxels, "
                 "%llu fits (%llu height, %llu models); start %.3f s, "
                 "fits %.3f s, flow %.3f s, redistance %.3f s, total %.3f s",
-                stage.level, stage.voxel_size, stage.shell_offset, stage.level == 0 ? "flow steps" : "snap passes",
-                stage.steps, stage.last_change, stage.noise, stage.height_noise,
-                stage.second_order ? "second order" : "plane fits", stage.height_neighbors, stage.smoothing,
-                static_cast<unsigned long long>(stage.buried_points), stage.carved_regions, stage.pierced_regions, stage.webs_cut,
+                stage.level, stage.voxel_size, stage.shell_offset,
+                stage.level == 0 ? "flow steps" : "snap passes", stage.steps, stage.last_change,
+                stage.noise, stage.height_noise, stage.second_order ? "second order" : "plane fits",
+                stage.height_neighbors, stage.smoothing,
+                static_cast<unsigned long long>(stage.buried_points), stage.carved_regions,
+                stage.pierced_regions, stage.webs_cut, stage.sheets_cut,
                 static_cast<unsigned long long>(stage.carved_voxels), stage.web_tunnels,
-                static_cast<unsigned long long>(stage.active_voxels), static_cast<unsigned long long>(stage.fit_voxels),
+                static_cast<unsigned long long>(stage.active_voxels),
+                static_cast<unsigned long long>(stage.fit_voxels),
                 static_cast<unsigned long long>(stage.height_fits),
-                static_cast<unsigned long long>(stage.fit_models), stage.seconds_start, stage.seconds_fit,
-                stage.seconds_flow, stage.seconds_redistance, stage.seconds);
+                static_cast<unsigned long long>(stage.fit_models), stage.seconds_start,
+                stage.seconds_fit, stage.seconds_flow, stage.seconds_redistance, stage.seconds);
   return line;
 }
 
@@ -269,6 +274,7 @@ ReconstructionResult reconstruct_surface(const std::vector<Vec3d>& input, const 
       where.carve.pierce = o.pierce_tunnels;
       where.carve.narrow = o.narrow_gaps;
       where.carve.cut_webs = o.cut_webs;
+      where.carve.cut_sheets = o.cut_sheets;
       where.carve.web_tunnels = o.web_tunnels && result.sampling.noise <= kMaxWebTunnelNoise * h_final;
       where.carve.fine_tunnels = where.carve.web_tunnels && level == levels - 1 &&
                                  result.sampling.noise <= kMaxFineTunnelNoise * h_final;

@@ -55,16 +55,19 @@
 //   them, farther than the sampling gap from every point and reaching the outside, turned
 //   outside by simple flips only, so no handle is made, except a gap lined almost only by
 //   buried points, which reopens whole, tunnels included: pierce_tunnels, CGAL's anchor and
-//   couplingdown; then, narrow_gaps, a second carving at 0.7 of that clearance, simple flips
-//   only: camel, hand, man at 20k points; under noise wider than half a final voxel, the
-//   clearance is measured from the points projected onto their neighbourhoods' planes,
+//   couplingdown; a sheet of the inside spanning a gap (cut_webs) whose removal would open a
+//   tunnel as it cuts a handle is cut through the bridge's rim instead, by flips that cut the
+//   inside and never join the outside, in the carving and the snaps after it: cut_sheets,
+//   homer's ankles at 200k points; then, narrow_gaps, a second carving at 0.7 of that clearance,
+//   simple flips only: camel, hand, man at 20k points; under noise wider than half a final voxel,
+//   the clearance is measured from the points projected onto their neighbourhoods' planes,
 //   denoised_clearance, apps/point_denoise.hpp, and a point's burial depth beyond the band's
 //   inner edge is read through the band; then at least 3 snap passes: homer's
-//   legs at 50k points, bench_reconstruct --sweep); then snap_passes times: every voxel within 1 voxel of the front computes its front offset
-//   e = clamp(s - u, -h, h) from fits of the points near the voxel (the others within 1.5
-//   voxels, which also move, take their neighbours' mean e; the voxels of a column along the
-//   normal share one fit, made at their centroid and evaluated at each, where its quadric
-//   patch is at least 4 voxels wide: SheetModel) (point_distance.hpp
+//   legs at 50k points, bench_reconstruct --sweep); then snap_passes times: every voxel within 1
+//   voxel of the front computes its front offset e = clamp(s - u, -h, h) from fits of the points
+//   near the voxel (the others within 1.5 voxels, which also move, take their neighbours' mean e;
+//   the voxels of a column along the normal share one fit, made at their centroid and evaluated at
+//   each, where its quadric patch is at least 4 voxels wide: SheetModel) (point_distance.hpp
 //   sheet_fit: the nearest points less those off the near sheet along the normal, so a part
 //   thinner than the neighbourhood is not flattened onto its middle plane), two of them:
 //   the plane (centroid) fit of the k nearest, with the curvature correction from the coarse
@@ -86,30 +89,28 @@
 //   (grid/topology_guard.hpp, also in the coarse flow except where no point lies within
 //   free_distance coarse voxels and the voxel is not in a gap between a sampled patch's points,
 //   apps/patch_coverage.hpp; a thin inside voxel holding a point within 0.75 coarse voxels, in
-//   such a patch, stays inside there (the guard's pinned rule: sheets do not erode); components the data do not support are dropped after the
-//   flow: sign_components), and the band is redistanced (fast sweeping, W)
-//   on its domain grown by one voxel (the front moved by up to one voxel; without the growth
-//   the band lacked voxels near the front where it moved outward, and the next upsampling or
-//   the marching cubes left holes). This is the
-//   p = 2 flow's fixed point reached in one step (the flow with the gain g = 2 / dt is the
-//   snap), valid because the upsampled coarse front lies within about a voxel of the data.
-//   Passes (snap_passes per level; on the final level at least clean_final_passes when the
-//   first pass found the data clean: the second pass refits along the corrected normals;
-//   mildly noisy data there (height-fit residual at most 0.7 final voxels), refit_moved: one
-//   more pass on the bricks whose voxels the last pass moved more than 0.25 voxel on average,
-//   where one pass of neighbourhood-averaged offsets stops short; widen_smooth: a later pass
-//   on a level gives 5/3 the points to the soft-scale height fits of the bricks where the pass
-//   before kept their largest patch with a mean weight of at least 0.4; facing_points: every
-//   pass first gives each point within max(0.5 voxel, 3 sigma) of the front the band's unit
-//   gradient there, and a voxel's fits leave out its nearest points that face away from its
-//   normal: the far side of a part thinner than the fits' band and the other wall of a narrow
-//   gap, which under noise sank the fits toward the part's middle)
-//   stop early when the mean |change| of the snapped voxels is below tolerance. A level's
-//   first pass may run before any level has read the noise; where its reading asks for 4 times
-//   the height fits' points or more, the final level, and a level whose fits read more noise
-//   than 0.7 final voxels, start again from the band before it
-//   (the few-point fits' noise would otherwise stay in the band: a pass moves each voxel by
-//   its neighbourhood's mean offset, which keeps the band's own high-frequency part).
+//   such a patch, stays inside there (the guard's pinned rule: sheets do not erode); components the
+//   data do not support are dropped after the flow: sign_components), and the band is redistanced
+//   (fast sweeping, W) on its domain grown by one voxel (the front moved by up to one voxel;
+//   without the growth the band lacked voxels near the front where it moved outward, and the next
+//   upsampling or the marching cubes left holes). This is the p = 2 flow's fixed point reached in
+//   one step (the flow with the gain g = 2 / dt is the snap), valid because the upsampled coarse
+//   front lies within about a voxel of the data. Passes (snap_passes per level; on the final level
+//   at least clean_final_passes when the first pass found the data clean: the second pass refits
+//   along the corrected normals; mildly noisy data there (height-fit residual at most 0.7 final
+//   voxels), refit_moved: one more pass on the bricks whose voxels the last pass moved more than
+//   0.25 voxel on average, where one pass of neighbourhood-averaged offsets stops short;
+//   widen_smooth: a later pass on a level gives 5/3 the points to the soft-scale height fits of the
+//   bricks where the pass before kept their largest patch with a mean weight of at least 0.4;
+//   facing_points: every pass first gives each point within max(0.5 voxel, 3 sigma) of the front
+//   the band's unit gradient there, and a voxel's fits leave out its nearest points that face away
+//   from its normal: the far side of a part thinner than the fits' band and the other wall of a
+//   narrow gap, which under noise sank the fits toward the part's middle) stop early when the mean
+//   |change| of the snapped voxels is below tolerance. A level's first pass may run before any
+//   level has read the noise; where its reading asks for 4 times the height fits' points or more,
+//   the final level, and a level whose fits read more noise than 0.7 final voxels, start again from
+//   the band before it (the few-point fits' noise would otherwise stay in the band: a pass moves
+//   each voxel by its neighbourhood's mean offset, which keeps the band's own high-frequency part).
 //   Output mesh: marching cubes of the final band (watertight by construction).
 // Output: ReconstructionResult (band in the input's world frame, mesh, measures, stages).
 // Cost: coarsest level O(steps * band) plus its fits; finer levels O(snap_passes * (voxels
@@ -125,12 +126,11 @@
 //   half_width not in [2, 8], levels not in [1, 6], neighbors not in [1, 256], negative
 //   curvature weight, tolerance <= 0, max_steps < 1, snap_passes or clean_final_passes not in
 //   [0, 16],
-//   shell_offset not in [1, 16], negative free_distance; the start shell's offset raised to close the
-//   samples' gaps is capped at 16 coarse voxels);
-//   Error{NonFinite} for a non-finite point (naming it) or option; Error{LimitExceeded}
-//   when the final grid would exceed max_resolution voxels along a side or the coarsest
-//   level's dense grid 2^27 voxels; Error{Cancelled} through progress (checked between
-//   steps and inside each phase).
+//   shell_offset not in [1, 16], negative free_distance; the start shell's offset raised to close
+//   the samples' gaps is capped at 16 coarse voxels); Error{NonFinite} for a non-finite point
+//   (naming it) or option; Error{LimitExceeded} when the final grid would exceed max_resolution
+//   voxels along a side or the coarsest level's dense grid 2^27 voxels; Error{Cancelled} through
+//   progress (checked between steps and inside each phase).
 // Log: options.log (may be empty) gets one line per level (steps, voxels, phase seconds) and
 //   one for the mesh, from the calling thread; a warning when under 70 % of the points lie
 //   near the surface (ReconstructionResult::coverage: a sampled open sheet collapses, parts
@@ -175,6 +175,9 @@ struct ReconstructionOptions {
   bool narrow_gaps = true;      // carve_gaps: a second carving reopens gaps narrower than the sampling gap's clearance
   bool cut_webs = true;         // carve_gaps: sheets of the inside exposed to the outside and clear of every point are cut where that removes a handle
   bool web_tunnels = true;      // carve_gaps: such sheets spanning a handle's hole (wherever they lie) are cut where that opens one tunnel (noise up to half a final voxel)
+  bool cut_sheets =
+      true;  // carve_gaps: sheets whose removal whole would not remove a handle are cut by cutting
+             // flips only, the snaps after may cut the bridge they span (no tunnels)
   bool denoised_clearance = true;  // carve_gaps under noise (sigma > 0.5 final voxels): clearance from points projected onto their planes
   int max_resolution = 4096;    // cap on the final grid's longest side (voxels)
   ProgressHook progress;
@@ -202,6 +205,7 @@ struct ReconstructionStage {
   int carved_regions = 0;           // finer levels: closed gaps reopened (turned outside)
   int pierced_regions = 0;          // of them reopened whole, tunnels allowed (pierce_tunnels), or webs cut
   int webs_cut = 0;                 // of those, webs (cut_webs)
+  int sheets_cut = 0;               // carved regions dug by cutting flips (cut_sheets)
   int web_tunnels = 0;              // finer levels: webs spanning a handle's hole cut, one tunnel each (web_tunnels)
   std::uint64_t refit_bricks = 0;   // final level, noisy data: bricks that took one more snap pass (refit_moved)
   std::uint64_t widened_bricks = 0;  // bricks whose height fits a later pass widened (widen_smooth), summed over passes

@@ -9,7 +9,6 @@
 #include <limits>
 #include <numeric>
 #include <optional>
-#include <unordered_set>
 #include <vector>
 
 #include <tbb/blocked_range.h>
@@ -365,9 +364,10 @@ RegionGroups group_by_region(const std::vector<std::uint32_t>& root) {
 
 namespace {
 
-RegionChoice carve_regions(const NarrowBand& band, const PointIndex& index, const std::vector<std::uint64_t>& air,
-                           const std::vector<float>& value, double lining_depth, double clearance, bool allow_pierce,
-                           bool cut_webs) {
+RegionChoice carve_regions(const NarrowBand& band, const PointIndex& index,
+                           const std::vector<std::uint64_t>& air, const std::vector<float>& value,
+                           double lining_depth, double clearance, bool allow_pierce, bool cut_webs,
+                           bool cut_sheets) {
   RegionChoice out;
   // 2. Regions: 6-connected components of the candidates.
   const std::vector<std::uint32_t> root = label_regions(air);
@@ -388,7 +388,7 @@ RegionChoice carve_regions(const NarrowBand& band, const PointIndex& index, cons
   // arms, man's at 200k points); it is cut (turned outside whole) where that removes a handle
   // or splits a part (euler_lost < 0), never where it would open a tunnel (a web only partly
   // clear of the points: cow and camel at 200k points gained handles).
-  std::vector<std::uint8_t> carve(air.size(), 0), pierce(air.size(), 0);
+  std::vector<std::uint8_t> carve(air.size(), 0), pierce(air.size(), 0), cut(air.size(), 0);
   const RegionGroups groups = cut_webs ? group_by_region(root) : RegionGroups{};
   BandAccessor acc(band);
   std::vector<std::uint64_t> members;
@@ -398,16 +398,21 @@ RegionChoice carve_regions(const NarrowBand& band, const PointIndex& index, cons
     if (r != i || size < kMinCarveVoxels) continue;
     const bool sealed = st.mouth[r] > 0 && buried >= kSealedGapLining * lining;
     const bool has_mouth = sealed || double(st.mouth[r]) >= kMinMouthShare * std::cbrt(size * size);
-    bool web = false;
+    bool web = false, sheet = false;
     if (cut_webs && double(st.exposed[r]) >= kWebExposure * size) {
       members.clear();
       for (std::uint32_t j = groups.start[r]; j < groups.start[r] + st.size[r]; ++j) members.push_back(air[groups.order[j]]);
       web = euler_lost(acc, members) < 0;
+      sheet = !web && cut_sheets;
     }
     const bool gap = has_mouth && buried >= kMinBuriedLining * lining;
-    if (!web && !gap) continue;
+    if (!web && !gap && !sheet) continue;
     carve[r] = 1;
     ++out.regions;
+    if (sheet) {
+      cut[r] = 1;
+      ++out.cut_sheets;
+    }
     if (web || (allow_pierce && size >= kMinPierceVoxels && buried >= kMinPierceLining * lining)) {
       pierce[r] = 1;
       ++out.pierced_regions;
@@ -417,58 +422,9 @@ RegionChoice carve_regions(const NarrowBand& band, const PointIndex& index, cons
   for (std::size_t i = 0; i < air.size(); ++i) {
     if (carve[root[i]]) out.carved.push_back(air[i]);
     if (pierce[root[i]]) out.pierced.push_back(air[i]);
+    if (cut[root[i]]) out.cuttable.push_back(air[i]);
   }
   return out;
-}
-
-// The inside scraps a cut web leaves (inside pieces of fewer than kMinPierceVoxels voxels,
-// 6-connected, every voxel active, beside a cut voxel: the web's rim was within the clearance
-// of a point and stayed; CGAL's bear_bis at 20k points, 0.5 % noise, kept one voxel apart)
-// turned outside. Each piece is found by a flood fill from the cut's inside neighbours that
-// stops past kMinPierceVoxels voxels or at an inactive one: O(cut voxels * 27 * 64) probes,
-// no grid-sized memory.
-void drop_web_scraps(NarrowBand& band, const std::vector<std::uint64_t>& cut) {
-  const Coord steps[6] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
-  BandAccessor acc(band);
-  std::unordered_set<std::uint64_t> seen;
-  std::vector<std::uint64_t> piece, scraps;
-  auto visited = [&](std::uint64_t k) { return std::find(piece.begin(), piece.end(), k) != piece.end(); };
-  for (const std::uint64_t k : cut) {
-    const Coord c = coord_of(k);
-    for (int d = 0; d < 27; ++d) {
-      const Coord start = c + Coord{d % 3 - 1, (d / 3) % 3 - 1, d / 9 - 1};
-      const std::uint64_t s = key_of(start);
-      const std::optional<float> u = acc.probe(start);
-      if (!u || *u >= 0.0f || seen.count(s) != 0) continue;
-      // Flood fill over active inside voxels; small: a linear search of the piece suffices.
-      piece.assign(1, s);
-      bool small = true;
-      for (std::size_t at = 0; at < piece.size() && small; ++at) {
-        const Coord v = coord_of(piece[at]);
-        for (const Coord& step : steps) {
-          const Coord q = v + step;
-          if (!acc.is_inside(q) || visited(key_of(q))) continue;
-          if (!acc.probe(q) || piece.size() >= kMinPierceVoxels) {
-            small = false;  // reaches the band's interior, or too large for a scrap
-            break;
-          }
-          piece.push_back(key_of(q));
-        }
-      }
-      if (small) scraps.insert(scraps.end(), piece.begin(), piece.end());
-      seen.insert(piece.begin(), piece.end());
-    }
-  }
-  if (scraps.empty()) return;
-  std::vector<float> values(band.values().begin(), band.values().end());
-  const float eps = float(1e-3 * band.voxel_size());
-  for (const std::uint64_t k : scraps) {
-    const Coord c = coord_of(k);
-    const Brick& br = band.bricks()[acc.locate(brick_of(c))];
-    float& v = values[br.value_offset + br.slot(local_index(c))];
-    v = std::max(-v, eps);
-  }
-  band.swap_values(values);
 }
 
 }  // namespace
@@ -510,6 +466,10 @@ Dug dig_regions(const NarrowBand& band, const RegionChoice& choice, const Progre
   guard.progress = progress;
   if (!pierced.empty())
     guard.free = [&](const Coord& c) { return std::binary_search(pierced.begin(), pierced.end(), key_of(c)); };
+  if (!choice.cuttable.empty())
+    guard.cuttable = [&](const Coord& c) {
+      return std::binary_search(choice.cuttable.begin(), choice.cuttable.end(), key_of(c));
+    };
   TopologyGuardResult kept = guard_topology(active, active, std::move(proposed), guard);
   out.carved_voxels = carved.size() - std::min<std::uint64_t>(carved.size(), kept.refused_flips);
   active.swap_values(kept.values);
@@ -522,6 +482,15 @@ Dug dig_regions(const NarrowBand& band, const RegionChoice& choice, const Progre
   }
   std::sort(out.bricks.begin(), out.bricks.end());
   out.bricks.erase(std::unique(out.bricks.begin(), out.bricks.end()), out.bricks.end());
+  for (const std::uint64_t k : choice.cuttable) {
+    const Coord c = coord_of(k);
+    for (int dz = -kCutZoneVoxels; dz <= kCutZoneVoxels; ++dz)
+      for (int dy = -kCutZoneVoxels; dy <= kCutZoneVoxels; ++dy)
+        for (int dx = -kCutZoneVoxels; dx <= kCutZoneVoxels; ++dx)
+          out.cut_zone.push_back(key_of(c + Coord{dx, dy, dz}));
+  }
+  std::sort(out.cut_zone.begin(), out.cut_zone.end());
+  out.cut_zone.erase(std::unique(out.cut_zone.begin(), out.cut_zone.end()), out.cut_zone.end());
   RedistanceOptions redo;
   redo.half_width = band.half_width();
   redo.progress = progress;
@@ -553,7 +522,8 @@ CarveOutput carve_once(NarrowBand band, const PointIndex& index, const CarveSett
       air_candidates(out.band, index, s.clearance_points ? *s.clearance_points : index, buried,
                      int(std::ceil(s.reach_voxels)), clearance, outer, progress);
   if (air.empty()) return out;
-  const RegionChoice choice = carve_regions(out.band, index, air, value, lining_depth, clearance, s.pierce, s.cut_webs);
+  const RegionChoice choice = carve_regions(out.band, index, air, value, lining_depth, clearance,
+                                            s.pierce, s.cut_webs, s.cut_sheets);
   out.regions = choice.regions;
   out.pierced_regions = choice.pierced_regions;
   out.webs = choice.webs;
@@ -562,6 +532,8 @@ CarveOutput carve_once(NarrowBand band, const PointIndex& index, const CarveSett
   out.band = std::move(dug.band);
   out.carved_voxels = dug.carved_voxels;
   out.bricks = std::move(dug.bricks);
+  out.cut_zone = std::move(dug.cut_zone);
+  out.cut_sheets = choice.cut_sheets;
   return out;
 }
 

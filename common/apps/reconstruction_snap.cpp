@@ -193,7 +193,7 @@ SnapOutput snap_level(NarrowBand band, const PointIndex& index, const Reconstruc
   const std::vector<float> coarse_curvature = mean_curvature_field(coarse);
   const auto t_up = Clock::now();
   band = level > 0 ? upsample(coarse, W, o.progress) : coarse;
-  std::vector<std::uint64_t> carved_bricks;
+  std::vector<std::uint64_t> carved_bricks, cut_zone;
   if (level > 0 && o.carve_gaps) {
     CarveOutput carved = carve_buried_gaps(std::move(band), index, where.carve, o.progress);
     band = std::move(carved.band);
@@ -201,13 +201,18 @@ SnapOutput snap_level(NarrowBand band, const PointIndex& index, const Reconstruc
     stage.carved_regions = carved.regions;
     stage.pierced_regions = carved.pierced_regions;
     stage.webs_cut = carved.webs;
+    stage.sheets_cut = carved.cut_sheets;
     stage.web_tunnels = carved.web_tunnels;
     stage.carved_voxels = carved.carved_voxels;
     carved_bricks = std::move(carved.bricks);
+    cut_zone = std::move(carved.cut_zone);
   }
   stage.seconds_start += seconds_since(t_up);
   auto settings_for = [&](bool refine) {
-    return snap_settings(o, band, index.size(), {previous_noise, previous_height_noise}, h, h_final, refine);
+    SnapSettings s = snap_settings(o, band, index.size(), {previous_noise, previous_height_noise},
+                                   h, h_final, refine);
+    s.cut_zone = &cut_zone;
+    return s;
   };
   // A pass on some bricks (settings.only), then the redistance (the front moved by up to a voxel).
   auto pass_on_bricks = [&](const SnapSettings& settings) {

@@ -11,6 +11,7 @@
 #include <tbb/parallel_for.h>
 
 #include "apps/nearby_points.hpp"
+#include "apps/reconstruction_parts.hpp"
 #include "grid/for_each_active_parallel.hpp"
 #include "grid/topology_guard.hpp"
 
@@ -302,11 +303,21 @@ SnapPass snap_to_fits(NarrowBand& band, const PointIndex& index, const SnapSetti
     TopologyGuardOptions guard;
     guard.eps = 1e-3 * h;
     guard.progress = progress;
+    // After a sheet was cut (settings.cut_zone): the flips connected to it may cut the inside.
+    std::vector<std::uint64_t> cuttable;
+    if (settings.cut_zone && !settings.cut_zone->empty()) {
+      cuttable = cutting_reach(band, next, *settings.cut_zone);
+      guard.cuttable = [&cuttable](const Coord& c) {
+        return std::binary_search(cuttable.begin(), cuttable.end(), key_of(c));
+      };
+    }
     TopologyGuardResult kept = guard_topology(band, band, std::move(next), guard);
-    next = std::move(kept.values);
     refused = kept.refused_flips;
+    band.swap_values(kept.values);
+    if (!cuttable.empty()) drop_web_scraps(band, cuttable);
+  } else {
+    band.swap_values(next);
   }
-  band.swap_values(next);
   SnapPass pass;
   pass.refused = refused;
   pass.noise = sigma;

@@ -101,6 +101,9 @@ struct SnapSettings {
   const std::vector<std::uint64_t>* widen = nullptr;
   int widened_neighbors = 0;
   bool facing_points = true;     // fits leave out the points facing away from the front (point_facing)
+  // When set: voxel keys (sorted) where the guard also takes flips that only cut the inside
+  // (CarveOutput::cut_zone, guard rule 1b).
+  const std::vector<std::uint64_t>* cut_zone = nullptr;
 };
 
 // One snap pass (apps/reconstruction.hpp describes it): every voxel with |u| < window h takes

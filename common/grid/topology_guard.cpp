@@ -81,6 +81,12 @@ bool simple_voxel(std::uint32_t inside) {
          neighbourhood_components(inside, true) == 1 && neighbourhood_components(outside, false) == 1;
 }
 
+bool cutting_voxel(std::uint32_t inside) {
+  const std::uint32_t outside = ~inside & ((1u << 27) - 1u);
+  return neighbourhood_components(outside, true) == 1 &&
+         neighbourhood_components(outside, false) == 1;
+}
+
 namespace {
 
 // Whether one of the 12 faces through the centre voxel (sign `centre`, neighbours `inside`)
@@ -116,8 +122,11 @@ bool ambiguous_face_at_centre(std::uint32_t inside, bool centre) {
 struct KeptTopology {
   std::uint64_t refused = 0, forced = 0;
 };
-KeptTopology keep_topology(const NarrowBand& before, const NarrowBand& after, std::vector<float>& values, double eps,
-                           const std::function<bool(const Coord&)>& free, const std::function<bool(const Coord&)>& pinned,
+KeptTopology keep_topology(const NarrowBand& before, const NarrowBand& after,
+                           std::vector<float>& values, double eps,
+                           const std::function<bool(const Coord&)>& free,
+                           const std::function<bool(const Coord&)>& pinned,
+                           const std::function<bool(const Coord&)>& cuttable,
                            const ProgressHook& progress) {
   struct Candidate {
     Coord c;
@@ -180,7 +189,10 @@ KeptTopology keep_topology(const NarrowBand& before, const NarrowBand& after, st
     }
     const bool keeps = simple_voxel(inside) && !ambiguous_face_at_centre(inside, !to_inside) &&
                        !ambiguous_face_at_centre(inside, to_inside);
-    if (!keeps && !(free && free(cand.c))) {
+    const bool cuts = !keeps && !to_inside && cuttable && cutting_voxel(inside) &&
+                      !ambiguous_face_at_centre(inside, true) &&
+                      !ambiguous_face_at_centre(inside, false) && cuttable(cand.c);
+    if (!keeps && !cuts && !(free && free(cand.c))) {
       if (!must_flip[k]) continue;
       ++kept.forced;
     }
@@ -308,7 +320,8 @@ TopologyGuardResult guard_topology(const NarrowBand& before, const NarrowBand& a
   TopologyGuardResult r;
   if (!(options.eps > 0.0) || !std::isfinite(options.eps))
     throw Error(ErrorCode::InvalidArgument, "guard_topology", "eps must be a positive number (a refused flip's |value|)");
-  const KeptTopology kept = keep_topology(before, after, values, options.eps, options.free, options.pinned, options.progress);
+  const KeptTopology kept = keep_topology(before, after, values, options.eps, options.free,
+                                          options.pinned, options.cuttable, options.progress);
   r.refused_flips = kept.refused;
   r.forced_flips = kept.forced;
   r.restored_values = keep_face_decisions(before, after, values);

@@ -37,17 +37,38 @@ nlohmann::json shape_json(const apps::ShapeMeasures& m) {
 nlohmann::json stages_json(const std::vector<apps::ReconstructionStage>& stages) {
   nlohmann::json levels = nlohmann::json::array();
   for (const apps::ReconstructionStage& s : stages)
-    levels.push_back({{"level", s.level},        {"voxel_size", s.voxel_size}, {"steps", s.steps}, {"shell_offset", s.shell_offset},
-                      {"converged", s.converged}, {"last_change", s.last_change}, {"noise", s.noise}, {"height_noise", s.height_noise},
-                      {"smoothing", s.smoothing},  {"second_order", s.second_order},
-                      {"height_fits", s.height_fits}, {"height_neighbors", s.height_neighbors},
-                      {"refused_flips", s.refused_flips}, {"dropped_components", s.dropped_components},
-                      {"buried_points", s.buried_points}, {"carved_regions", s.carved_regions}, {"pierced_regions", s.pierced_regions}, {"webs_cut", s.webs_cut}, {"web_tunnels", s.web_tunnels}, {"refit_bricks", s.refit_bricks}, {"widened_bricks", s.widened_bricks}, {"facing_fits", s.facing_fits},
+    levels.push_back({{"level", s.level},
+                      {"voxel_size", s.voxel_size},
+                      {"steps", s.steps},
+                      {"shell_offset", s.shell_offset},
+                      {"converged", s.converged},
+                      {"last_change", s.last_change},
+                      {"noise", s.noise},
+                      {"height_noise", s.height_noise},
+                      {"smoothing", s.smoothing},
+                      {"second_order", s.second_order},
+                      {"height_fits", s.height_fits},
+                      {"height_neighbors", s.height_neighbors},
+                      {"refused_flips", s.refused_flips},
+                      {"dropped_components", s.dropped_components},
+                      {"buried_points", s.buried_points},
+                      {"carved_regions", s.carved_regions},
+                      {"pierced_regions", s.pierced_regions},
+                      {"webs_cut", s.webs_cut},
+                      {"sheets_cut", s.sheets_cut},
+                      {"web_tunnels", s.web_tunnels},
+                      {"refit_bricks", s.refit_bricks},
+                      {"widened_bricks", s.widened_bricks},
+                      {"facing_fits", s.facing_fits},
                       {"carved_voxels", s.carved_voxels},
                       {"active_voxels", s.active_voxels},
-                      {"fit_voxels", s.fit_voxels}, {"fit_models", s.fit_models}, {"seconds", s.seconds},
-                      {"seconds_start", s.seconds_start}, {"seconds_fit", s.seconds_fit},
-                      {"seconds_flow", s.seconds_flow}, {"seconds_redistance", s.seconds_redistance}});
+                      {"fit_voxels", s.fit_voxels},
+                      {"fit_models", s.fit_models},
+                      {"seconds", s.seconds},
+                      {"seconds_start", s.seconds_start},
+                      {"seconds_fit", s.seconds_fit},
+                      {"seconds_flow", s.seconds_flow},
+                      {"seconds_redistance", s.seconds_redistance}});
   return levels;
 }
 

@@ -6,17 +6,17 @@
 // Every run also reports the fit: the distances from the input points to the result.
 //   input { points = FILE (.xyz .xyzn .pwn .ply)  |  sample = knot  |  sample_mesh = FILE
 //           count = 20000  noise = 0 (x the bbox diagonal)  seed = 1 }
-//   reconstruct { levels = 0 (from the data)  neighbors = 8  curvature_weight = 0.3  max_steps = 120
+//   reconstruct { levels = 0 (from the data)  neighbors = 8  curvature_weight = 0.3  max_steps =
+//   120
 //                 snap_passes = 1  clean_final_passes = 2  tolerance = 0.01  shell_offset = 1
-//                 guard_flow = yes  guard_snaps = yes  free_distance = 1  carve_gaps = yes  pierce_tunnels = yes  narrow_gaps = yes
-//                 cut_webs = yes  web_tunnels = yes  denoised_clearance = yes  refit_moved = yes  widen_smooth = yes
-//                 facing_points = yes
-//                 accuracy_samples = 100000 }
+//                 guard_flow = yes  guard_snaps = yes  free_distance = 1  carve_gaps = yes
+//                 pierce_tunnels = yes  narrow_gaps = yes cut_webs = yes  cut_sheets = yes
+//                 web_tunnels = yes  denoised_clearance = yes  refit_moved = yes  widen_smooth =
+//                 yes facing_points = yes accuracy_samples = 100000 }
 //   (guard_*: keep the start shell's topology in the coarse flow / the snaps; free_distance:
 //   coarse voxels from the nearest sample beyond which the flow may change it; carve_gaps,
-//   pierce_tunnels, narrow_gaps, cut_webs, web_tunnels, denoised_clearance, refit_moved, widen_smooth,
-//   facing_points:
-//   apps/reconstruction.hpp's options)
+//   pierce_tunnels, narrow_gaps, cut_webs, cut_sheets, web_tunnels, denoised_clearance,
+//   refit_moved, widen_smooth, facing_points: apps/reconstruction.hpp's options)
 // The raster's resolution / voxel_size / band are the final level's; with neither resolution
 // nor voxel_size the resolution follows from the points (stats: reconstruct.resolution,
 // resolution_from_data, sampling).
@@ -36,8 +36,14 @@ namespace levelset::jobs {
 
 void run_reconstruct_job(JobContext& ctx) {
   const config::Set& in = ctx.section("input", {"points", "sample", "sample_mesh", "count", "noise", "seed"});
-  const config::Set& s = ctx.section("reconstruct", {"levels", "neighbors", "curvature_weight", "max_steps", "snap_passes",
-                                                     "clean_final_passes", "guard_flow", "guard_snaps", "free_distance", "carve_gaps", "pierce_tunnels", "narrow_gaps", "cut_webs", "web_tunnels", "denoised_clearance", "refit_moved", "widen_smooth", "facing_points", "tolerance", "shell_offset", "accuracy_samples"});
+  const config::Set& s =
+      ctx.section("reconstruct",
+                  {"levels",        "neighbors",          "curvature_weight", "max_steps",
+                   "snap_passes",   "clean_final_passes", "guard_flow",       "guard_snaps",
+                   "free_distance", "carve_gaps",         "pierce_tunnels",   "narrow_gaps",
+                   "cut_webs",      "cut_sheets",         "web_tunnels",      "denoised_clearance",
+                   "refit_moved",   "widen_smooth",       "facing_points",    "tolerance",
+                   "shell_offset",  "accuracy_samples"});
   const int given = (ctx.has(in, "points") ? 1 : 0) + (ctx.has(in, "sample") ? 1 : 0) + (ctx.has(in, "sample_mesh") ? 1 : 0);
   if (given != 1)
     throw Error(ErrorCode::InvalidArgument, ctx.options().name,
@@ -64,6 +70,7 @@ void run_reconstruct_job(JobContext& ctx) {
   o.narrow_gaps = ctx.flag(s, "narrow_gaps", o.narrow_gaps);
   o.cut_webs = ctx.flag(s, "cut_webs", o.cut_webs);
   o.web_tunnels = ctx.flag(s, "web_tunnels", o.web_tunnels);
+  o.cut_sheets = ctx.flag(s, "cut_sheets", o.cut_sheets);
   o.denoised_clearance = ctx.flag(s, "denoised_clearance", o.denoised_clearance);
   o.refit_moved = ctx.flag(s, "refit_moved", o.refit_moved);
   o.widen_smooth = ctx.flag(s, "widen_smooth", o.widen_smooth);

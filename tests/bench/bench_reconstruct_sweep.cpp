@@ -16,7 +16,9 @@
 //   --meshes a.off,b.off (only these)  --max-meshes N  --ours (no Poisson)  --list (the meshes
 //   and their measurements only)  --jsonl FILE (one record per case, appended)
 //   --cache DIR (Poisson's results by case, default reconstruct-sweep-cache; reused).
-//   Development: --levels L, --shell-offset S, --curvature-weight W, --free-distance F, --no-carve, --no-web-tunnels, --no-refit-moved, --no-widen-smooth, --no-facing-points (reconstruction options);
+//   Development: --levels L, --shell-offset S, --curvature-weight W, --free-distance F, --no-carve,
+//   --no-web-tunnels, --no-cut-sheets, --no-refit-moved, --no-widen-smooth, --no-facing-points
+//   (reconstruction options);
 //   --keep DIR writes each case's points (KEY-points.xyz) and our surface (KEY-ours.ply);
 //   --log: the reconstruction's per-level lines with each level's topology on stderr.
 #include <algorithm>
@@ -66,6 +68,7 @@ struct SweepOptions {
   bool log = false;  // the reconstruction's per-level lines and topology on stderr
   bool no_carve = false;
   bool no_web_tunnels = false;
+  bool no_cut_sheets = false;
   bool no_refit_moved = false;
   bool no_widen_smooth = false;
   bool no_facing_points = false;
@@ -109,6 +112,8 @@ SweepOptions parse(int argc, char** argv) {
     else if (arg == "--log") o.log = true;
     else if (arg == "--no-carve") o.no_carve = true;
     else if (arg == "--no-web-tunnels") o.no_web_tunnels = true;
+    else if (arg == "--no-cut-sheets")
+      o.no_cut_sheets = true;
     else if (arg == "--no-refit-moved") o.no_refit_moved = true;
     else if (arg == "--no-widen-smooth") o.no_widen_smooth = true;
     else if (arg == "--no-facing-points") o.no_facing_points = true;
@@ -285,6 +290,7 @@ CaseResult run_case(const SweepMesh& m, const std::vector<Vec3d>& truth_samples,
   if (o.free_distance >= 0) ro.free_distance = o.free_distance;
   ro.carve_gaps = !o.no_carve;
   ro.web_tunnels = !o.no_web_tunnels;
+  ro.cut_sheets = !o.no_cut_sheets;
   ro.refit_moved = !o.no_refit_moved;
   ro.widen_smooth = !o.no_widen_smooth;
   ro.facing_points = !o.no_facing_points;

@@ -9,6 +9,8 @@
 #include "grid/build_from_sdf.hpp"
 #include "grid/sign_components.hpp"
 #include "grid/topology_guard.hpp"
+#include "surface/marching_cubes.hpp"
+#include "surface/mesh_measures.hpp"
 
 namespace levelset {
 namespace {
@@ -229,6 +231,75 @@ TEST(TopologyGuard, FreeFlipsOfAWholeFaceAreNotUndone) {
   const TopologyGuardResult r = guard_topology(checker, checker, values_of(swapped), o);
   EXPECT_EQ(r.refused_flips, 0u);
   EXPECT_EQ(r.values, values_of(swapped));
+}
+
+TEST(CuttingVoxel, CutsAndDropsPassTunnelsAndCavitiesDoNot) {
+  auto bit = [](int dx, int dy, int dz) { return 1u << ((dz + 1) * 9 + (dy + 1) * 3 + dx + 1); };
+  std::uint32_t below = 0;
+  for (int dy = -1; dy <= 1; ++dy)
+    for (int dx = -1; dx <= 1; ++dx) below |= bit(dx, dy, -1);
+  EXPECT_TRUE(cutting_voxel(below));  // simple flips cut nothing, and pass too
+  EXPECT_TRUE(cutting_voxel(bit(0, 0, -1) | bit(0, 0, 1)));  // a rod's middle: the rod is cut
+  EXPECT_TRUE(cutting_voxel(0u));                            // a lone voxel is dropped
+  std::uint32_t disc = 0;  // the centre of a one-voxel plate: turning it outside opens a hole
+  for (int dy = -1; dy <= 1; ++dy)
+    for (int dx = -1; dx <= 1; ++dx)
+      if (dx != 0 || dy != 0) disc |= bit(dx, dy, 0);
+  EXPECT_FALSE(cutting_voxel(disc));
+  EXPECT_FALSE(cutting_voxel((1u << 27) - 1u));  // buried: a cavity
+}
+
+double genus_of(const NarrowBand& band) {
+  return measure_mesh(marching_cubes(band).mesh).genus;
+}
+
+TEST(TopologyGuard, CuttableVoxelsCutARingButNeverPunchAPlate) {
+  // A ring (torus, tube 2-3 voxels thick) proposed outside across one section: the guard alone
+  // refuses the last flips that would cut it; where the section is cuttable it is cut (one
+  // arc left, genus 0), and nothing else changes.
+  const double h = 0.1;
+  const NarrowBand ring =
+      band_of([](const Vec3d& p) { return std::hypot(std::hypot(p.x, p.y) - 0.6, p.z) - 0.13; },
+              -1.0, 1.0, h);
+  ASSERT_EQ(genus_of(ring), 1.0);
+  std::vector<float> proposed = values_of(ring);
+  std::size_t i = 0;
+  ring.for_each_active_world([&](const Coord&, const Vec3d& p, float v) {
+    if (p.x > 0.45 && std::abs(p.y) < 0.25) proposed[i] = std::abs(v) + 0.01f;
+    ++i;
+  });
+  TopologyGuardOptions o;
+  o.eps = 1e-3 * h;
+  NarrowBand kept = ring;
+  std::vector<float> values = guard_topology(ring, ring, proposed, o).values;
+  kept.swap_values(values);
+  EXPECT_EQ(genus_of(kept), 1.0);
+  o.cuttable = [](const Coord&) { return true; };
+  NarrowBand cut = ring;
+  values = guard_topology(ring, ring, proposed, o).values;
+  cut.swap_values(values);
+  EXPECT_EQ(genus_of(cut), 0.0);
+  EXPECT_EQ(inside_components(cut), 1u);
+  // A plate two voxels thick proposed outside in a patch of its middle: cutting flips would
+  // have to open a hole through it (a tunnel), which rule 1b never takes.
+  const NarrowBand plate = band_of(
+      [](const Vec3d& p) {
+        return std::max(std::abs(p.z) - 0.1, std::max(std::abs(p.x), std::abs(p.y)) - 0.7);
+      },
+      -1.0, 1.0, h);
+  ASSERT_EQ(genus_of(plate), 0.0);
+  proposed = values_of(plate);
+  i = 0;
+  plate.for_each_active_world([&](const Coord&, const Vec3d& p, float v) {
+    if (std::abs(p.x) < 0.25 && std::abs(p.y) < 0.25) proposed[i] = std::abs(v) + 0.01f;
+    ++i;
+  });
+  NarrowBand punched = plate;
+  TopologyGuardResult r = guard_topology(plate, plate, proposed, o);
+  EXPECT_GT(r.refused_flips, 0u);
+  punched.swap_values(r.values);
+  EXPECT_EQ(genus_of(punched), 0.0);
+  EXPECT_EQ(inside_components(punched), 1u);
 }
 
 }  // namespace
