@@ -378,5 +378,16 @@ struct SnapOutput {
 // single level the flow's band as it is), then snapped onto the fits pass after pass.
 SnapOutput snap_level(NarrowBand coarse, const PointIndex& index, const ReconstructionOptions& o,
                       const SnapLevel& where, ReconstructionStage stage, SnapNoise previous);
+// The band redistanced (fast sweeping, half-width W, on its domain less `shrink` voxels) after
+// a snap pass that moved only the voxels of the bricks `moved` (brick_key, sorted): only the
+// bricks within one brick of them are recomputed (the front moved by at most a voxel there,
+// and a distance within W + 1 < 8 voxels of it is all that can change), from a copy of the
+// band holding every brick within two more (those not allocated with their signs and no
+// active voxel, so that no sign is guessed along a row near them); the other bricks are kept.
+// The same values as a redistance of the whole band up to the sweep's tolerance, at a cost in
+// the bricks moved, not in the band: the passes on carved and moved bricks (snap_level) redo
+// a few percent of the band.
+NarrowBand redistanced_near(const NarrowBand& band, const std::vector<std::uint64_t>& moved,
+                            double W, double shrink, const ProgressHook& progress);
 
 }  // namespace levelset::apps::detail

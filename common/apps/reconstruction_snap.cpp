@@ -8,6 +8,8 @@
 #include "apps/reconstruction_parts.hpp"
 #include "apps/reconstruction_snap_pass.hpp"
 #include "distance/redistance.hpp"
+#include "grid/band_accessor.hpp"
+#include "grid/band_builder.hpp"
 #include "grid/for_each_active_parallel.hpp"
 
 namespace levelset::apps::detail {
@@ -181,7 +183,63 @@ NarrowBand redistanced(const NarrowBand& band, double W, double shrink, const Pr
   return redistance(reframed(band, {}, W - shrink), redo).band;
 }
 
+// Copies brick b of `band` (active voxels, inside bits, values) into `builder`.
+void copy_brick(const NarrowBand& band, std::uint32_t b, BandBuilder& builder,
+                std::vector<float>& values) {
+  const Brick& br = band.bricks()[b];
+  std::size_t slot = br.value_offset;
+  br.active.for_each_set([&](int n) { values[std::size_t(n)] = band.values()[slot++]; });
+  builder.add_brick(br.coord, br.active, band.inside_mask(b), values.data());
+}
+
 }  // namespace
+
+NarrowBand redistanced_near(const NarrowBand& band, const std::vector<std::uint64_t>& moved,
+                            double W, double shrink, const ProgressHook& progress) {
+  auto dilate = [](const std::vector<Coord>& from, int r) {
+    std::vector<Coord> out;
+    for (const Coord& c : from)
+      for (int dz = -r; dz <= r; ++dz)
+        for (int dy = -r; dy <= r; ++dy)
+          for (int dx = -r; dx <= r; ++dx) out.push_back(c + Coord{dx, dy, dz});
+    std::sort(out.begin(), out.end(),
+              [](const Coord& a, const Coord& b) { return brick_key(a) < brick_key(b); });
+    out.erase(std::unique(out.begin(), out.end()), out.end());
+    return out;
+  };
+  std::vector<Coord> seeds;
+  BandAccessor acc(band);
+  for (std::uint32_t b = 0; b < band.brick_count(); ++b)
+    if (std::binary_search(moved.begin(), moved.end(), brick_key(band.bricks()[b].coord)))
+      seeds.push_back(band.bricks()[b].coord);
+  if (seeds.empty()) return band;  // nothing moved
+  const std::vector<Coord> near = dilate(seeds, 1), context = dilate(near, 2);
+  BandBuilder sub_builder(band.frame());
+  std::vector<float> values(kBrickVoxels, 0.0f);
+  for (const Coord& c : context) {
+    const std::uint32_t b = acc.locate(c);
+    if (b != kNoBrick) {
+      copy_brick(band, b, sub_builder, values);
+      continue;
+    }
+    BrickMask inside{};
+    const Coord o = brick_origin(c);
+    for (int n = 0; n < kBrickVoxels; ++n) inside.assign(n, acc.is_inside(o + local_coord(n)));
+    sub_builder.add_brick(c, BrickMask{}, inside, values.data());
+  }
+  const NarrowBand redone = redistanced(sub_builder.finish(band.far_inside()), W, shrink, progress);
+  auto in_near = [&](const Coord& c) {
+    return std::binary_search(near.begin(), near.end(), c, [](const Coord& a, const Coord& b) {
+      return brick_key(a) < brick_key(b);
+    });
+  };
+  BandBuilder merged(redone.frame());
+  for (std::uint32_t b = 0; b < band.brick_count(); ++b)
+    if (!in_near(band.bricks()[b].coord)) copy_brick(band, b, merged, values);
+  for (std::uint32_t b = 0; b < redone.brick_count(); ++b)
+    if (in_near(redone.bricks()[b].coord)) copy_brick(redone, b, merged, values);
+  return merged.finish(band.far_inside());
+}
 
 SnapOutput snap_level(NarrowBand band, const PointIndex& index, const ReconstructionOptions& o,
                       const SnapLevel& where, ReconstructionStage stage, SnapNoise previous) {
@@ -224,7 +282,7 @@ SnapOutput snap_level(NarrowBand band, const PointIndex& index, const Reconstruc
     stage.facing_fits += snapped.facing_fits;
     stage.seconds_fit += seconds_since(t_fit);
     const auto t_redistance = Clock::now();
-    band = redistanced(band, W, 1.0, o.progress);
+    band = redistanced_near(band, *settings.only, W, 1.0, o.progress);
     stage.seconds_redistance += seconds_since(t_redistance);
   };
   for (int pass = 0; !carved_bricks.empty() && pass < kPassesAfterCarving; ++pass) {
