@@ -32,10 +32,9 @@ std::vector<std::uint64_t> cutting_reach(const NarrowBand& band, const std::vect
     const Coord c = coord_of(leaving[stack.back()]);
     stack.pop_back();
     for (int d = 0; d < 27; ++d) {
-      const auto it = std::lower_bound(leaving.begin(), leaving.end(),
-                                       key_of(c + Coord{d % 3 - 1, (d / 3) % 3 - 1, d / 9 - 1}));
-      if (it == leaving.end() || *it != key_of(c + Coord{d % 3 - 1, (d / 3) % 3 - 1, d / 9 - 1}))
-        continue;
+      const std::uint64_t key = key_of(c + Coord{d % 3 - 1, (d / 3) % 3 - 1, d / 9 - 1});
+      const auto it = std::lower_bound(leaving.begin(), leaving.end(), key);
+      if (it == leaving.end() || *it != key) continue;
       const std::size_t j = std::size_t(it - leaving.begin());
       if (reached[j]) continue;
       reached[j] = 1;
